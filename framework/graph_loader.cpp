@@ -1,0 +1,444 @@
+// Graph file format (docs/graph-format.md):
+//   { "description": "...", "plugins": [...], "variables": {...},
+//     "include": [{"file": "chain.json", "as": "chain", "variables": {...}}],
+//     "nodes": {"name": {"type": "family.stage", "params": {...}}},
+//     "edges": [["a.out", "b.in"], {"from": "a.out", "to": "b.in"}],
+//     "runtime": {"max_in_flight": 4, "when_full": "block", "on_error": "skip"} }
+// A node of the including file with the name of an included node replaces it when it
+// names a type, and otherwise overrides only the parameters it lists.
+#include "framework/graph_loader.h"
+
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "framework/diagnostics.h"
+#include "framework/nearest_names.h"
+
+namespace tilth {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables",
+                                                "include",     "nodes",   "edges",
+                                                "runtime"};
+const std::vector<std::string> kNodeKeys = {"type", "params", "description"};
+const std::vector<std::string> kIncludeKeys = {"file", "as", "variables"};
+const std::vector<std::string> kRuntimeKeys = {"max_in_flight", "when_full", "on_error"};
+
+std::pair<int, int> line_and_column(const std::string& text, std::size_t byte) {
+  int line = 1;
+  int column = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {line, column};
+}
+
+// nlohmann's messages start with "[json.exception.parse_error.101] parse error at line
+// 3, column 5: "; keep what follows.
+std::string parse_error_reason(const std::string& what) {
+  const auto colon = what.find(": ");
+  return colon == std::string::npos ? what : what.substr(colon + 2);
+}
+
+std::string scalar_text(const json& value) {
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+class Loader {
+ public:
+  Loader(const GraphOverrides& overrides, Diagnostics& diagnostics)
+      : diagnostics_(diagnostics) {
+    for (const auto& variable : overrides.variables) {
+      command_line_variables_[variable.key] = parse_value(variable.value);
+    }
+  }
+
+  void load(const fs::path& file, const std::string& prefix, const json& include_variables,
+            const Location& included_from) {
+    const std::string name = file.lexically_normal().string();
+    if (std::find(chain_.begin(), chain_.end(), name) != chain_.end()) {
+      std::string cycle;
+      for (const auto& link : chain_) cycle += link + " -> ";
+      diagnostics_.add(included_from, "include cycle: " + cycle + name);
+      return;
+    }
+    std::ifstream in(file);
+    if (!in) {
+      diagnostics_.add(included_from.file.empty() ? Location{name, ""} : included_from,
+                       "cannot read graph file '" + name + "'");
+      return;
+    }
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const std::string text = buffer.str();
+    json document;
+    try {
+      document = json::parse(text, nullptr, true, /*ignore_comments=*/true);
+    } catch (const json::parse_error& error) {
+      const auto [line, column] = line_and_column(text, error.byte == 0 ? 0 : error.byte - 1);
+      diagnostics_.add({name, "", line, column},
+                       "malformed JSON: " + parse_error_reason(error.what()));
+      return;
+    }
+    const Location root{name, ""};
+    if (!document.is_object()) {
+      diagnostics_.add(root, "expected a JSON object with \"nodes\" and \"edges\"");
+      return;
+    }
+    chain_.push_back(name);
+    check_keys(document, root, kTopLevelKeys, "graph file");
+    const json variables = resolve_variables(document, root, include_variables);
+    const fs::path dir = file.parent_path();
+
+    if (chain_.size() == 1 && document.contains("description") &&
+        document["description"].is_string()) {
+      graph_.description = document["description"].get<std::string>();
+    }
+    load_plugins(document, root, dir);
+    load_includes(document, root, dir, prefix, variables);
+    load_nodes(document, root, dir, prefix, variables);
+    load_edges(document, root, prefix);
+    load_runtime(document, root);
+    chain_.pop_back();
+  }
+
+  void apply(const std::vector<Setting>& settings) {
+    for (const auto& setting : settings) {
+      const Location where{"command line", "--set " + setting.key};
+      const auto dot = setting.key.find('.');
+      if (dot == std::string::npos || dot == 0 || dot + 1 == setting.key.size()) {
+        diagnostics_.add(where, "expected NODE.PARAM=VALUE");
+        continue;
+      }
+      const std::string node_name = setting.key.substr(0, dot);
+      const std::string param = setting.key.substr(dot + 1);
+      if (node_name == "runtime") {
+        json runtime = {{param, parse_value(setting.value)}};
+        apply_runtime(runtime, where);
+        continue;
+      }
+      NodeSpec* node = find_node(node_name);
+      if (node == nullptr) {
+        diagnostics_.add(where, "no node named '" + node_name + "'" +
+                                    did_you_mean(node_name, node_names()));
+        continue;
+      }
+      node->params[param] = {parse_value(setting.value), where, fs::current_path(),
+                             setting.value};
+    }
+  }
+
+  GraphSpec take(const fs::path& file) {
+    graph_.file = file;
+    return std::move(graph_);
+  }
+
+ private:
+  static json parse_value(const std::string& text) {
+    try {
+      return json::parse(text);
+    } catch (const json::parse_error&) {
+      return text;
+    }
+  }
+
+  void check_keys(const json& object, const Location& where, const std::vector<std::string>& known,
+                  const std::string& what) {
+    for (const auto& [key, value] : object.items()) {
+      if (std::find(known.begin(), known.end(), key) == known.end()) {
+        diagnostics_.add(where.child(key), "unknown key '" + key + "' in " + what +
+                                               did_you_mean(key, known) + " (expected one of " +
+                                               quoted_list(known) + ")");
+      }
+    }
+  }
+
+  // The file's own variables, overridden by those its includer passes, overridden by the
+  // command line.
+  json resolve_variables(const json& document, const Location& root, const json& from_includer) {
+    json variables = json::object();
+    if (document.contains("variables")) {
+      if (document["variables"].is_object()) {
+        variables = document["variables"];
+      } else {
+        diagnostics_.add(root.child("variables"), "expected an object of name: value");
+      }
+    }
+    for (const auto& [key, value] : from_includer.items()) variables[key] = value;
+    for (const auto& [key, value] : command_line_variables_) variables[key] = value;
+    return variables;
+  }
+
+  // "${name}" alone becomes the variable's value with its type; "${name}" inside a
+  // longer string is replaced by its text.
+  json substitute(const json& value, const json& variables, const Location& where) {
+    if (value.is_object()) {
+      json result = json::object();
+      for (const auto& [key, item] : value.items()) {
+        result[key] = substitute(item, variables, where.child(key));
+      }
+      return result;
+    }
+    if (value.is_array()) {
+      json result = json::array();
+      for (std::size_t i = 0; i < value.size(); ++i) {
+        result.push_back(substitute(value[i], variables, where.child(std::to_string(i))));
+      }
+      return result;
+    }
+    if (!value.is_string()) return value;
+    static const std::regex kReference(R"(\$\{([A-Za-z_][A-Za-z0-9_]*)\})");
+    const std::string text = value.get<std::string>();
+    std::smatch whole;
+    if (std::regex_match(text, whole, kReference)) return lookup(whole[1], variables, where);
+    std::string result;
+    auto begin = text.cbegin();
+    for (std::sregex_iterator it(text.begin(), text.end(), kReference), end; it != end; ++it) {
+      result.append(begin, text.cbegin() + it->position());
+      result += scalar_text(lookup((*it)[1], variables, where));
+      begin = text.cbegin() + it->position() + it->length();
+    }
+    result.append(begin, text.cend());
+    return result;
+  }
+
+  json lookup(const std::string& name, const json& variables, const Location& where) {
+    if (variables.contains(name)) return variables[name];
+    std::vector<std::string> known;
+    for (const auto& [key, value] : variables.items()) known.push_back(key);
+    diagnostics_.add(where, "unknown variable '" + name + "'" + did_you_mean(name, known) +
+                                " (defined: " + quoted_list(known) + ")");
+    return nullptr;
+  }
+
+  void load_plugins(const json& document, const Location& root, const fs::path& dir) {
+    if (!document.contains("plugins")) return;
+    const json& plugins = document["plugins"];
+    if (!plugins.is_array()) {
+      diagnostics_.add(root.child("plugins"), "expected an array of plugin library paths");
+      return;
+    }
+    for (std::size_t i = 0; i < plugins.size(); ++i) {
+      if (!plugins[i].is_string()) {
+        diagnostics_.add(root.child("plugins").child(std::to_string(i)),
+                         "expected a plugin library path (a string)");
+        continue;
+      }
+      graph_.plugins.push_back(dir / plugins[i].get<std::string>());
+    }
+  }
+
+  void load_includes(const json& document, const Location& root, const fs::path& dir,
+                     const std::string& prefix, const json& variables) {
+    if (!document.contains("include")) return;
+    const json& includes = document["include"];
+    const Location list = root.child("include");
+    if (!includes.is_array()) {
+      diagnostics_.add(list, "expected an array of {\"file\": ..., \"as\": ...}");
+      return;
+    }
+    for (std::size_t i = 0; i < includes.size(); ++i) {
+      const Location where = list.child(std::to_string(i));
+      json entry = includes[i].is_string() ? json{{"file", includes[i]}} : includes[i];
+      if (!entry.is_object() || !entry.contains("file") || !entry["file"].is_string()) {
+        diagnostics_.add(where, "expected a file name or {\"file\": ..., \"as\": ...}");
+        continue;
+      }
+      check_keys(entry, where, kIncludeKeys, "include");
+      std::string nested_prefix = prefix;
+      if (entry.contains("as")) {
+        const json& as = entry["as"];
+        if (!as.is_string() || as.get<std::string>().empty() ||
+            as.get<std::string>().find_first_of("./") != std::string::npos) {
+          diagnostics_.add(where.child("as"), "expected a name without '.' or '/'");
+          continue;
+        }
+        nested_prefix += as.get<std::string>() + "/";
+      }
+      json passed = json::object();
+      if (entry.contains("variables")) {
+        passed = substitute(entry["variables"], variables, where.child("variables"));
+        if (!passed.is_object()) {
+          diagnostics_.add(where.child("variables"), "expected an object of name: value");
+          passed = json::object();
+        }
+      }
+      load(dir / entry["file"].get<std::string>(), nested_prefix, passed, where.child("file"));
+    }
+  }
+
+  void load_nodes(const json& document, const Location& root, const fs::path& dir,
+                  const std::string& prefix, const json& variables) {
+    if (!document.contains("nodes")) return;
+    const json& nodes = document["nodes"];
+    const Location list = root.child("nodes");
+    if (!nodes.is_object()) {
+      diagnostics_.add(list, "expected an object of node name: {\"type\": ..., \"params\": ...}");
+      return;
+    }
+    for (const auto& [local_name, body] : nodes.items()) {
+      const Location where = list.child(local_name);
+      if (local_name.empty() || local_name.find('.') != std::string::npos ||
+          local_name == "runtime") {
+        diagnostics_.add(where, "node names must be non-empty, without '.', and not 'runtime'");
+        continue;
+      }
+      if (!body.is_object()) {
+        diagnostics_.add(where, "expected {\"type\": ..., \"params\": ...}");
+        continue;
+      }
+      check_keys(body, where, kNodeKeys, "node");
+      const std::string name = prefix + local_name;
+      NodeSpec* node = find_node(name);
+      if (body.contains("type")) {
+        if (!body["type"].is_string()) {
+          diagnostics_.add(where.child("type"), "expected a stage type name (a string)");
+          continue;
+        }
+        if (node == nullptr) {
+          graph_.nodes.push_back({});
+          node = &graph_.nodes.back();
+        }
+        *node = NodeSpec{name, body["type"].get<std::string>(), where, {}};
+      } else if (node == nullptr) {
+        diagnostics_.add(where, "node '" + name +
+                                    "' has no \"type\" and overrides no included node" +
+                                    did_you_mean(name, node_names()));
+        continue;
+      }
+      if (!body.contains("params")) continue;
+      const Location params_where = where.child("params");
+      if (!body["params"].is_object()) {
+        diagnostics_.add(params_where, "expected an object of parameter: value");
+        continue;
+      }
+      for (const auto& [param, value] : body["params"].items()) {
+        const Location param_where = params_where.child(param);
+        node->params[param] = {substitute(value, variables, param_where), param_where, dir, {}};
+      }
+    }
+  }
+
+  void load_edges(const json& document, const Location& root, const std::string& prefix) {
+    if (!document.contains("edges")) return;
+    const json& edges = document["edges"];
+    const Location list = root.child("edges");
+    if (!edges.is_array()) {
+      diagnostics_.add(list, "expected an array of [\"node.port\", \"node.port\"]");
+      return;
+    }
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const Location where = list.child(std::to_string(i));
+      const json& edge = edges[i];
+      json from;
+      json to;
+      if (edge.is_array() && edge.size() == 2) {
+        from = edge[0];
+        to = edge[1];
+      } else if (edge.is_object() && edge.contains("from") && edge.contains("to")) {
+        from = edge["from"];
+        to = edge["to"];
+      }
+      if (!from.is_string() || !to.is_string()) {
+        diagnostics_.add(where,
+                         "expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": ...}");
+        continue;
+      }
+      graph_.edges.push_back({prefix + from.get<std::string>(), prefix + to.get<std::string>(),
+                              where});
+    }
+  }
+
+  void load_runtime(const json& document, const Location& root) {
+    if (!document.contains("runtime")) return;
+    const Location where = root.child("runtime");
+    if (!document["runtime"].is_object()) {
+      diagnostics_.add(where, "expected an object with max_in_flight, when_full, on_error");
+      return;
+    }
+    check_keys(document["runtime"], where, kRuntimeKeys, "runtime");
+    apply_runtime(document["runtime"], where);
+  }
+
+  void apply_runtime(const json& runtime, const Location& where) {
+    for (const auto& [key, value] : runtime.items()) {
+      const Location at = where.file == "command line" ? where : where.child(key);
+      if (key == "max_in_flight") {
+        if (value.is_number_integer() && value.get<std::int64_t>() >= 1 &&
+            value.get<std::int64_t>() <= 1024) {
+          graph_.runtime.max_in_flight = value.get<std::size_t>();
+        } else {
+          diagnostics_.add(at, "expected an integer in [1, 1024], got " + value.dump());
+        }
+      } else if (key == "when_full") {
+        if (value == "block") {
+          graph_.runtime.when_full = FullPolicy::kBlock;
+        } else if (value == "drop_oldest") {
+          graph_.runtime.when_full = FullPolicy::kDropOldest;
+        } else {
+          diagnostics_.add(at, "expected 'block' or 'drop_oldest', got " + value.dump());
+        }
+      } else if (key == "on_error") {
+        if (value == "skip") {
+          graph_.runtime.on_error = ErrorPolicy::kSkipFrame;
+        } else if (value == "stop") {
+          graph_.runtime.on_error = ErrorPolicy::kStop;
+        } else {
+          diagnostics_.add(at, "expected 'skip' or 'stop', got " + value.dump());
+        }
+      } else if (where.file == "command line") {
+        diagnostics_.add(at, "unknown runtime option '" + key + "'" +
+                                 did_you_mean(key, kRuntimeKeys));
+      }
+    }
+  }
+
+  NodeSpec* find_node(const std::string& name) {
+    for (auto& node : graph_.nodes) {
+      if (node.name == name) return &node;
+    }
+    return nullptr;
+  }
+
+  std::vector<std::string> node_names() const {
+    std::vector<std::string> names;
+    for (const auto& node : graph_.nodes) names.push_back(node.name);
+    return names;
+  }
+
+  Diagnostics& diagnostics_;
+  GraphSpec graph_;
+  std::vector<std::string> chain_;
+  std::map<std::string, json> command_line_variables_;
+};
+
+}  // namespace
+
+Setting parse_setting(const std::string& option, const std::string& text) {
+  const auto equals = text.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw Error(option + " " + text + ": expected KEY=VALUE");
+  }
+  return {text.substr(0, equals), text.substr(equals + 1)};
+}
+
+GraphSpec load_graph(const fs::path& file, const GraphOverrides& overrides) {
+  Diagnostics diagnostics;
+  Loader loader(overrides, diagnostics);
+  loader.load(file, "", nlohmann::json::object(), Location{});
+  if (diagnostics.empty()) loader.apply(overrides.params);
+  diagnostics.throw_if_any();
+  return loader.take(file);
+}
+
+}  // namespace tilth

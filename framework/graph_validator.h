@@ -1,0 +1,39 @@
+// Checks a graph against the stage types before anything runs: every type, port, edge
+// and parameter, all problems at once. The result is what the runtime builds from.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "framework/graph_spec.h"
+#include "framework/stage_registry.h"
+#include "tilth/params.h"
+
+namespace tilth {
+
+struct InputBinding {
+  std::size_t node;  // index of the upstream node in ValidatedGraph::nodes
+  std::size_t port;  // its output port
+};
+
+struct ResolvedNode {
+  std::string name;
+  const StageRegistry::Entry* stage;
+  Params params;
+  Location where;
+  std::vector<InputBinding> inputs;     // one per input port, in port order
+  std::vector<std::size_t> successors;  // distinct, ascending
+};
+
+struct ValidatedGraph {
+  std::filesystem::path file;
+  std::string description;
+  std::vector<ResolvedNode> nodes;  // in topological order
+  RuntimeOptions runtime;
+};
+
+// Throws GraphError with every problem found.
+ValidatedGraph validate_graph(const GraphSpec& graph, const StageRegistry& registry);
+
+}  // namespace tilth

@@ -1,0 +1,359 @@
+#include "framework/runtime.h"
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <oneapi/tbb/flow_graph.h>
+
+#include "framework/frame_admission.h"
+#include "framework/keyed_join.h"
+#include "framework/latency_histogram.h"
+#include "framework/sequence_reorder.h"
+#include "tilth/log.h"
+
+namespace tilth {
+namespace {
+
+std::int64_t steady_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+std::int64_t host_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+struct Node {
+  ResolvedNode spec;
+  StageInstance instance;
+  Source* source = nullptr;
+  Transform* transform = nullptr;
+  Sink* sink = nullptr;
+  std::vector<std::size_t> predecessors;                      // distinct node indices
+  std::vector<std::pair<std::size_t, std::size_t>> input_of;  // per input port: (slot, port)
+  std::unique_ptr<KeyedJoin> join;
+  bool ordered = false;
+  std::mutex order_mutex;
+  SequenceReorder<std::vector<BundlePtr>> reorder;
+  std::unique_ptr<tbb::flow::function_node<BundlePtr>> flow_node;
+  LatencyHistogram latency;
+  std::atomic<std::uint64_t> errors{0};
+  std::atomic<std::uint64_t> skipped{0};
+
+  const std::string& type() const { return spec.stage->descriptor.type; }
+  std::string label() const { return "node '" + spec.name + "' (" + type() + ")"; }
+};
+
+}  // namespace
+
+class Runtime::Impl {
+ public:
+  Impl(ValidatedGraph graph, const StageRegistry& registry, RunLimits limits)
+      : graph_(std::move(graph)), limits_(limits) {
+    make_stages(registry);
+    wire();
+    admission_ = std::make_unique<FrameAdmission>(
+        sources_.size(), graph_.runtime.max_in_flight, graph_.runtime.when_full,
+        [this](std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> bundles) {
+          admit(sequence, std::move(bundles));
+        },
+        limits_.max_frames);
+  }
+
+  RunResult run() {
+    {
+      std::lock_guard lock(done_mutex_);
+      start_ns_ = steady_now_ns();
+    }
+    std::vector<std::thread> threads;
+    for (std::size_t s = 0; s < sources_.size(); ++s) {
+      threads.emplace_back([this, s] { pump(s); });
+    }
+    admission_->wait_until_drained();
+    interrupt_sources();
+    for (auto& thread : threads) thread.join();
+    flow_.wait_for_all();
+    finish_stages();
+    RunResult result;
+    result.metrics = metrics();
+    std::lock_guard lock(failure_mutex_);
+    result.failed = failed_;
+    result.failure = failure_;
+    return result;
+  }
+
+  void stop() {
+    stopping_ = true;
+    admission_->close();
+    interrupt_sources();
+  }
+
+  PipelineMetrics metrics() const {
+    PipelineMetrics result;
+    for (const auto& node : nodes_) {
+      result.stages.push_back({node->spec.name, node->type(), node->latency.summary(),
+                               node->errors.load(), node->skipped.load()});
+    }
+    result.frames_admitted = admission_->admitted();
+    result.frames_dropped = admission_->dropped();
+    result.frames_in_flight = admission_->in_flight();
+    result.end_to_end = end_to_end_.summary();
+    std::lock_guard lock(done_mutex_);
+    result.frames_completed = completed_;
+    if (completed_ > 0 && last_done_ns_ > start_ns_) {
+      result.frames_per_second =
+          static_cast<double>(completed_) / (static_cast<double>(last_done_ns_ - start_ns_) * 1e-9);
+    }
+    return result;
+  }
+
+ private:
+  void make_stages(const StageRegistry& registry) {
+    std::string failures;
+    for (auto& spec : graph_.nodes) {
+      auto node = std::make_unique<Node>();
+      node->spec = std::move(spec);
+      StageContext context{node->spec.name, node->spec.params, Logger(node->spec.name),
+                           [this] { return metrics(); }};
+      try {
+        node->instance = registry.create(node->type(), context);
+      } catch (const Error& failure) {
+        failures += std::string(failures.empty() ? "" : "\n") + failure.what();
+      }
+      Stage* stage = node->instance.stage.get();
+      node->source = dynamic_cast<Source*>(stage);
+      node->transform = dynamic_cast<Transform*>(stage);
+      node->sink = dynamic_cast<Sink*>(stage);
+      const StageKind kind = node->spec.stage->descriptor.kind();
+      const bool matches = (kind == StageKind::kSource && node->source) ||
+                           (kind == StageKind::kTransform && node->transform) ||
+                           (kind == StageKind::kSink && node->sink);
+      if (stage != nullptr && !matches) {
+        failures += std::string(failures.empty() ? "" : "\n") + node->label() +
+                    ": the stage object is not a " + std::string(to_string(kind)) +
+                    " although its ports make it one";
+      }
+      nodes_.push_back(std::move(node));
+    }
+    if (!failures.empty()) throw Error(failures);
+  }
+
+  void wire() {
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      Node& node = *nodes_[i];
+      if (node.source) sources_.push_back(i);
+      if (node.spec.successors.empty()) ++terminal_count_;
+      for (const auto& input : node.spec.inputs) {
+        auto slot = std::find(node.predecessors.begin(), node.predecessors.end(), input.node);
+        if (slot == node.predecessors.end()) {
+          node.predecessors.push_back(input.node);
+          slot = node.predecessors.end() - 1;
+        }
+        node.input_of.emplace_back(slot - node.predecessors.begin(), input.port);
+      }
+      if (node.source) continue;
+      node.join = std::make_unique<KeyedJoin>(node.predecessors.size());
+      node.ordered = node.sink || node.spec.stage->descriptor.concurrency == Concurrency::kSerial;
+      node.flow_node = std::make_unique<tbb::flow::function_node<BundlePtr>>(
+          flow_, node.ordered ? tbb::flow::serial : tbb::flow::unlimited,
+          [this, i](const BundlePtr& bundle) {
+            receive(i, bundle);
+            return tbb::flow::continue_msg();
+          });
+    }
+  }
+
+  // A source's thread: produce, stamp, offer, until the stream ends or the graph stops.
+  void pump(std::size_t source_index) {
+    Node& node = *nodes_[sources_[source_index]];
+    const std::size_t outputs = node.spec.stage->descriptor.outputs.size();
+    while (!stopping_) {
+      auto bundle = std::make_shared<Bundle>();
+      bundle->node = sources_[source_index];
+      bundle->outputs.resize(outputs);
+      Frame frame(FrameInfo{}, {}, bundle->outputs);
+      bool more = false;
+      const std::int64_t begin = steady_now_ns();
+      try {
+        more = node.source->produce(frame);
+      } catch (const std::exception& failure) {
+        ++node.errors;
+        fail(node.label() + " failed: " + failure.what() + "; its stream ends here", true);
+      }
+      if (!more) break;
+      node.latency.record(steady_now_ns() - begin);
+      bundle->info = frame.info();
+      if (bundle->info.host_timestamp_ns == 0) bundle->info.host_timestamp_ns = host_now_ns();
+      if (!admission_->offer(source_index, std::move(bundle))) break;
+    }
+    admission_->end_of_stream(source_index);
+  }
+
+  void admit(std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> bundles) {
+    {
+      std::lock_guard lock(done_mutex_);
+      remaining_[sequence] = terminal_count_;
+    }
+    for (auto& bundle : bundles) {
+      bundle->info.sequence = sequence;
+      for (auto& packet : bundle->outputs) {
+        if (!packet.empty()) packet = Packet(bundle->info, packet.message());
+      }
+    }
+    for (auto& bundle : bundles) {
+      const std::size_t from = bundle->node;
+      deliver(from, std::move(bundle));
+    }
+  }
+
+  void deliver(std::size_t from, BundlePtr bundle) {
+    const auto& successors = nodes_[from]->spec.successors;
+    if (successors.empty()) {
+      frame_done(bundle->info);
+      return;
+    }
+    for (std::size_t next : successors) nodes_[next]->flow_node->try_put(bundle);
+  }
+
+  void receive(std::size_t index, const BundlePtr& bundle) {
+    Node& node = *nodes_[index];
+    const std::size_t slot =
+        std::find(node.predecessors.begin(), node.predecessors.end(), bundle->node) -
+        node.predecessors.begin();
+    auto complete = node.join->add(bundle->info.sequence, slot, bundle);
+    if (!complete) return;
+    if (!node.ordered) {
+      execute(index, *complete);
+      return;
+    }
+    std::lock_guard lock(node.order_mutex);
+    for (auto& ready : node.reorder.push(bundle->info.sequence, std::move(*complete))) {
+      execute(index, ready);
+    }
+  }
+
+  void execute(std::size_t index, const std::vector<BundlePtr>& arrived) {
+    Node& node = *nodes_[index];
+    const FrameInfo info = arrived.front()->info;
+    std::vector<Packet> inputs;
+    bool missing = false;
+    for (const auto& [slot, port] : node.input_of) {
+      inputs.push_back(arrived[slot]->outputs[port]);
+      missing = missing || inputs.back().empty();
+    }
+    auto result = std::make_shared<Bundle>();
+    result->node = index;
+    result->info = info;
+    result->outputs.resize(node.spec.stage->descriptor.outputs.size());
+    if (missing) {
+      ++node.skipped;
+      if (node.sink) call_guarded(node, info, [&] { node.sink->skipped(info); });
+    } else {
+      Frame frame(info, inputs, result->outputs);
+      const std::int64_t begin = steady_now_ns();
+      const bool ok = call_guarded(node, info, [&] {
+        if (node.transform) {
+          node.transform->process(frame);
+        } else {
+          node.sink->consume(frame);
+        }
+      });
+      node.latency.record(steady_now_ns() - begin);
+      if (!ok) std::fill(result->outputs.begin(), result->outputs.end(), Packet{});
+    }
+    deliver(index, std::move(result));
+  }
+
+  template <class Call>
+  bool call_guarded(Node& node, const FrameInfo& info, Call&& call) {
+    std::string what;
+    try {
+      call();
+      return true;
+    } catch (const std::exception& failure) {
+      what = failure.what();
+    } catch (...) {
+      what = "unknown exception";
+    }
+    ++node.errors;
+    const std::string message = node.label() + " failed on frame " + std::to_string(info.frame_id) +
+                                " (sequence " + std::to_string(info.sequence) + "): " + what;
+    if (graph_.runtime.on_error == ErrorPolicy::kStop) {
+      fail(message + "; stopping (on_error: stop)", true);
+      stop();
+    } else {
+      log(LogLevel::kError, "runtime", message + "; frame skipped (on_error: skip)");
+    }
+    return false;
+  }
+
+  void fail(const std::string& message, bool log_it) {
+    if (log_it) log(LogLevel::kError, "runtime", message);
+    std::lock_guard lock(failure_mutex_);
+    if (!failed_) failure_ = message;
+    failed_ = true;
+  }
+
+  void frame_done(const FrameInfo& info) {
+    {
+      std::lock_guard lock(done_mutex_);
+      auto it = remaining_.find(info.sequence);
+      if (--it->second > 0) return;
+      remaining_.erase(it);
+      ++completed_;
+      last_done_ns_ = steady_now_ns();
+    }
+    end_to_end_.record(host_now_ns() - info.host_timestamp_ns);
+    admission_->complete();
+  }
+
+  void interrupt_sources() {
+    for (std::size_t s : sources_) nodes_[s]->source->interrupt();
+  }
+
+  void finish_stages() {
+    for (auto& node : nodes_) {
+      try {
+        node->instance.stage->finish();
+      } catch (const std::exception& failure) {
+        ++node->errors;
+        fail(node->label() + " failed to finish: " + failure.what(), true);
+      }
+    }
+  }
+
+  ValidatedGraph graph_;
+  const RunLimits limits_;
+  tbb::flow::graph flow_;  // before nodes_: outlives every flow node
+  std::vector<std::unique_ptr<Node>> nodes_;
+  std::vector<std::size_t> sources_;
+  std::size_t terminal_count_ = 0;
+  std::unique_ptr<FrameAdmission> admission_;
+  std::atomic<bool> stopping_{false};
+
+  mutable std::mutex done_mutex_;
+  std::map<std::uint64_t, std::size_t> remaining_;  // terminal nodes still to finish, per frame
+  std::uint64_t completed_ = 0;
+  std::int64_t start_ns_ = 0;
+  std::int64_t last_done_ns_ = 0;
+  LatencyHistogram end_to_end_;
+
+  std::mutex failure_mutex_;
+  bool failed_ = false;
+  std::string failure_;
+};
+
+Runtime::Runtime(ValidatedGraph graph, const StageRegistry& registry, RunLimits limits)
+    : impl_(std::make_unique<Impl>(std::move(graph), registry, limits)) {}
+Runtime::~Runtime() = default;
+RunResult Runtime::run() { return impl_->run(); }
+void Runtime::stop() { impl_->stop(); }
+PipelineMetrics Runtime::metrics() const { return impl_->metrics(); }
+
+}  // namespace tilth

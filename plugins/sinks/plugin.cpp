@@ -1,0 +1,4 @@
+// Sinks: where measurements leave the graph.
+#include "tilth/plugin.h"
+
+TILTH_PLUGIN("sinks")

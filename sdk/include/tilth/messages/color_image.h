@@ -1,0 +1,29 @@
+// Colour image with the pixel format it is stored in (packed or Bayer mosaic).
+#pragma once
+
+#include <optional>
+#include <string_view>
+
+#include <opencv2/core/mat.hpp>
+
+#include "tilth/message.h"
+
+namespace tilth {
+
+enum class PixelFormat { kBgr8, kRgb8, kMono8, kBayerRggb8, kBayerBggr8, kBayerGrbg8, kBayerGbrg8 };
+
+// Names as in the recording format: "bgr8", "bayer_rggb8", ...
+std::string_view to_string(PixelFormat format);
+std::optional<PixelFormat> parse_pixel_format(std::string_view name);
+int channels(PixelFormat format);
+
+struct ColorImage : MessageOf<ColorImage> {
+  static constexpr std::string_view kTypeName = "tilth.ColorImage";
+
+  cv::Mat pixels;  // CV_8UC3 for bgr8/rgb8, CV_8UC1 for mono8 and Bayer
+  PixelFormat format = PixelFormat::kBgr8;
+
+  std::string summary() const override;
+};
+
+}  // namespace tilth

@@ -1,0 +1,105 @@
+// Summaries and names of the shared message types.
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include <opencv2/core.hpp>
+
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/ground_distance.h"
+#include "tilth/messages/pipeline_metrics.h"
+#include "tilth/messages/raw_tof_frame.h"
+#include "tilth/messages/residue_mask.h"
+
+namespace tilth {
+namespace {
+
+constexpr std::array<std::pair<PixelFormat, std::string_view>, 7> kPixelFormatNames{{
+    {PixelFormat::kBgr8, "bgr8"},
+    {PixelFormat::kRgb8, "rgb8"},
+    {PixelFormat::kMono8, "mono8"},
+    {PixelFormat::kBayerRggb8, "bayer_rggb8"},
+    {PixelFormat::kBayerBggr8, "bayer_bggr8"},
+    {PixelFormat::kBayerGrbg8, "bayer_grbg8"},
+    {PixelFormat::kBayerGbrg8, "bayer_gbrg8"},
+}};
+
+std::string size_of(const cv::Mat& image) {
+  return std::to_string(image.cols) + "x" + std::to_string(image.rows);
+}
+
+}  // namespace
+
+std::string_view to_string(PixelFormat format) {
+  for (const auto& [value, name] : kPixelFormatNames) {
+    if (value == format) return name;
+  }
+  return "unknown";
+}
+
+std::optional<PixelFormat> parse_pixel_format(std::string_view name) {
+  for (const auto& [value, known] : kPixelFormatNames) {
+    if (known == name) return value;
+  }
+  return std::nullopt;
+}
+
+int channels(PixelFormat format) {
+  return format == PixelFormat::kBgr8 || format == PixelFormat::kRgb8 ? 3 : 1;
+}
+
+std::string RawTofFrame::summary() const { return "raw ToF " + size_of(gray); }
+
+std::string DepthImage::summary() const {
+  int valid = 0;
+  double sum = 0.0;
+  for (int r = 0; r < mm.rows; ++r) {
+    const float* row = mm.ptr<float>(r);
+    for (int c = 0; c < mm.cols; ++c) {
+      if (std::isfinite(row[c])) {
+        ++valid;
+        sum += row[c];
+      }
+    }
+  }
+  std::ostringstream out;
+  out << "depth " << size_of(mm) << ", " << valid << " valid px";
+  if (valid > 0) out << ", mean " << sum / valid << " mm";
+  return out.str();
+}
+
+std::string ColorImage::summary() const {
+  return "colour " + size_of(pixels) + " " + std::string(to_string(format));
+}
+
+std::string ResidueMask::summary() const {
+  const int total = values.rows * values.cols;
+  const int residue = total == 0 ? 0 : cv::countNonZero(values == kResidue);
+  return "mask " + size_of(values) + ", " + std::to_string(residue) + " residue px";
+}
+
+std::string GroundDistance::summary() const {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(2);
+  if (valid) {
+    out << distance_mm << " mm";
+  } else {
+    out << "invalid (" << invalid_reason << ")";
+  }
+  out << ", soil " << soil_fraction * 100.0 << " %, confidence " << confidence;
+  return out.str();
+}
+
+std::string PipelineMetrics::summary() const {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(1);
+  out << frames_completed << " frames, " << frames_per_second << " fps, " << frames_dropped
+      << " dropped, end-to-end p50 " << end_to_end.p50_ms << " ms";
+  return out.str();
+}
+
+}  // namespace tilth

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs every Debian package Tilth needs to build, test and run. Idempotent: when
+# everything is present it only checks and returns.
+set -euo pipefail
+
+packages=(
+  # build
+  build-essential cmake ninja-build ccache pkg-config clang-format
+  # framework and SDK
+  libtbb-dev nlohmann-json3-dev libboost-dev libboost-filesystem-dev
+  libopencv-dev libeigen3-dev
+  # cameras (GigE Vision) and the camera simulator used by the tests
+  libaravis-dev aravis-tools libusb-1.0-0-dev iproute2
+  # machine outputs and their real peers in tests
+  libmodbus-dev mbpoll python3-pymodbus
+  # recordings
+  libzstd-dev liblz4-dev nodejs
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev graphviz
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+# Node.js builds that bundle npm (NodeSource) conflict with Debian's npm package.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
