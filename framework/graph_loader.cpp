@@ -19,7 +19,9 @@
 namespace tilth {
 namespace {
 
-using nlohmann::json;
+// ordered_json keeps nodes and keys in the order written, so problems are reported in
+// file order.
+using json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
 const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables",
@@ -133,8 +135,8 @@ class Loader {
                                     did_you_mean(node_name, node_names()));
         continue;
       }
-      node->params[param] = {parse_value(setting.value), where, fs::current_path(),
-                             setting.value};
+      node->params[param] = {nlohmann::json(parse_value(setting.value)), where,
+                             fs::current_path(), setting.value};
     }
   }
 
@@ -324,7 +326,8 @@ class Loader {
       }
       for (const auto& [param, value] : body["params"].items()) {
         const Location param_where = params_where.child(param);
-        node->params[param] = {substitute(value, variables, param_where), param_where, dir, {}};
+        node->params[param] = {nlohmann::json(substitute(value, variables, param_where)),
+                               param_where, dir, {}};
       }
     }
   }
@@ -435,7 +438,7 @@ Setting parse_setting(const std::string& option, const std::string& text) {
 GraphSpec load_graph(const fs::path& file, const GraphOverrides& overrides) {
   Diagnostics diagnostics;
   Loader loader(overrides, diagnostics);
-  loader.load(file, "", nlohmann::json::object(), Location{});
+  loader.load(file, "", json::object(), Location{});
   if (diagnostics.empty()) loader.apply(overrides.params);
   diagnostics.throw_if_any();
   return loader.take(file);

@@ -71,10 +71,18 @@ class Runtime::Impl {
       std::lock_guard lock(done_mutex_);
       start_ns_ = steady_now_ns();
     }
+    // This thread works in the flow graph's arena (wait_for_all) until every admitted
+    // frame is done; the reservation keeps it there while sources may still admit.
+    flow_.reserve_wait();
     std::vector<std::thread> threads;
+    threads.emplace_back([this] {
+      admission_->wait_until_drained();
+      flow_.release_wait();
+    });
     for (std::size_t s = 0; s < sources_.size(); ++s) {
       threads.emplace_back([this, s] { pump(s); });
     }
+    flow_.wait_for_all();
     admission_->wait_until_drained();
     interrupt_sources();
     for (auto& thread : threads) thread.join();

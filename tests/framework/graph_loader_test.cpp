@@ -1,0 +1,176 @@
+// Graph files: includes, variables, overrides, and the exact error for each way a file
+// can be wrong.
+#include "framework/graph_loader.h"
+
+#include <gtest/gtest.h>
+
+#include "framework/diagnostics.h"
+#include "temp_dir.h"
+
+namespace tilth {
+namespace {
+
+using testing::TempDir;
+
+std::string load_error(const std::filesystem::path& file, const GraphOverrides& overrides = {}) {
+  try {
+    load_graph(file, overrides);
+  } catch (const GraphError& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+const NodeSpec& node(const GraphSpec& graph, const std::string& name) {
+  for (const auto& n : graph.nodes) {
+    if (n.name == name) return n;
+  }
+  throw Error("no node " + name);
+}
+
+TEST(GraphLoader, ReadsNodesEdgesAndRuntime) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({
+    "description": "two nodes",
+    "nodes": {"src": {"type": "test.counter", "params": {"count": 5}},
+              "out": {"type": "test.record"}},
+    "edges": [["src.out", "out.in"]],
+    "runtime": {"max_in_flight": 2, "when_full": "drop_oldest", "on_error": "stop"}
+  })");
+  const GraphSpec graph = load_graph(file);
+  EXPECT_EQ(graph.description, "two nodes");
+  ASSERT_EQ(graph.nodes.size(), 2u);
+  EXPECT_EQ(node(graph, "src").params.at("count").value, 5);
+  EXPECT_EQ(node(graph, "src").params.at("count").where.text(),
+            file.string() + ":/nodes/src/params/count");
+  ASSERT_EQ(graph.edges.size(), 1u);
+  EXPECT_EQ(graph.edges[0].from, "src.out");
+  EXPECT_EQ(graph.edges[0].to, "out.in");
+  EXPECT_EQ(graph.runtime.max_in_flight, 2u);
+  EXPECT_EQ(graph.runtime.when_full, FullPolicy::kDropOldest);
+  EXPECT_EQ(graph.runtime.on_error, ErrorPolicy::kStop);
+}
+
+TEST(GraphLoader, MalformedJsonGivesLineAndColumn) {
+  TempDir dir;
+  const auto file = dir.write("bad.json", "{\n  \"nodes\": {\n    \"a\": {\"type\": \"x\",}\n  }\n}\n");
+  EXPECT_EQ(load_error(file),
+            file.string() +
+                ":3:23: malformed JSON: syntax error while parsing object key - unexpected '}'; "
+                "expected string literal");
+}
+
+TEST(GraphLoader, MissingFileIsReported) {
+  EXPECT_EQ(load_error("/nonexistent/g.json"), "/nonexistent/g.json: cannot read graph file "
+                                               "'/nonexistent/g.json'");
+}
+
+TEST(GraphLoader, IncludesAreNamespacedAndOverridable) {
+  TempDir dir;
+  dir.write("chain.json", R"({
+    "variables": {"gain": 1.0},
+    "nodes": {"delay": {"type": "test.delay", "params": {"add": "${gain}"}},
+              "out": {"type": "test.record", "params": {"mode": "fast"}}},
+    "edges": [["delay.out", "out.in"]]
+  })");
+  const auto file = dir.write("machine.json", R"({
+    "include": [{"file": "chain.json", "as": "chain", "variables": {"gain": 3}}],
+    "nodes": {"src": {"type": "test.counter"},
+              "chain/out": {"params": {"mode": "exact"}}},
+    "edges": [["src.out", "chain/delay.in"]]
+  })");
+  const GraphSpec graph = load_graph(file);
+  ASSERT_EQ(graph.nodes.size(), 3u);
+  EXPECT_EQ(node(graph, "chain/delay").params.at("add").value, 3);
+  EXPECT_EQ(node(graph, "chain/out").type, "test.record");
+  EXPECT_EQ(node(graph, "chain/out").params.at("mode").value, "exact");
+  EXPECT_EQ(node(graph, "chain/out").params.at("mode").where.text(),
+            file.string() + ":/nodes/chain~1out/params/mode");
+  ASSERT_EQ(graph.edges.size(), 2u);
+  EXPECT_EQ(graph.edges[0].from, "chain/delay.out");
+  EXPECT_EQ(graph.edges[1].to, "chain/delay.in");
+}
+
+TEST(GraphLoader, NodeWithTypeReplacesIncludedNode) {
+  TempDir dir;
+  dir.write("base.json", R"({"nodes": {"src": {"type": "test.counter", "params": {"count": 9}}}})");
+  const auto file = dir.write("g.json", R"({
+    "include": ["base.json"],
+    "nodes": {"src": {"type": "test.other"}}
+  })");
+  const GraphSpec graph = load_graph(file);
+  ASSERT_EQ(graph.nodes.size(), 1u);
+  EXPECT_EQ(graph.nodes[0].type, "test.other");
+  EXPECT_TRUE(graph.nodes[0].params.empty());
+}
+
+TEST(GraphLoader, CommandLineOverridesParamsVariablesAndRuntime) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({
+    "variables": {"n": 4, "name": "run"},
+    "nodes": {"src": {"type": "test.counter", "params": {"count": "${n}"}},
+              "out": {"type": "test.record", "params": {"file": "${name}-${n}.txt"}}}
+  })");
+  GraphOverrides overrides;
+  overrides.variables = {{"n", "7"}};
+  overrides.params = {{"out.file", "x.csv"}, {"runtime.max_in_flight", "8"}, {"src.count", "12"}};
+  const GraphSpec graph = load_graph(file, overrides);
+  EXPECT_EQ(node(graph, "src").params.at("count").value, 12);
+  EXPECT_EQ(node(graph, "out").params.at("file").value, "x.csv");
+  EXPECT_EQ(node(graph, "out").params.at("file").base_dir, std::filesystem::current_path());
+  EXPECT_EQ(graph.runtime.max_in_flight, 8u);
+
+  const GraphSpec with_vars = load_graph(file, {{}, {{"n", "7"}}});
+  EXPECT_EQ(node(with_vars, "out").params.at("file").value, "run-7.txt");
+  EXPECT_EQ(node(with_vars, "src").params.at("count").value, 7);
+}
+
+TEST(GraphLoader, ReportsEveryProblemAtOnce) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({
+    "nodez": {},
+    "nodes": {"a": {"type": "test.counter", "params": {"count": "${missing}"}},
+              "b": {"params": {"x": 1}},
+              "c.d": {"type": "test.record"}},
+    "edges": [["a.out"]],
+    "runtime": {"when_full": "drop_newest"}
+  })");
+  const std::string f = file.string();
+  EXPECT_EQ(load_error(file),
+            f + ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
+                "of 'description', 'plugins', 'variables', 'include', 'nodes', 'edges', "
+                "'runtime')\n" +
+                f + ":/nodes/a/params/count: unknown variable 'missing' (defined: none)\n" + f +
+                ":/nodes/b: node 'b' has no \"type\" and overrides no included node; did you mean "
+                "'a'?\n" + f +
+                ":/nodes/c.d: node names must be non-empty, without '.', and not 'runtime'\n" + f +
+                ":/edges/0: expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": "
+                "...}\n" +
+                f + ":/runtime/when_full: expected 'block' or 'drop_oldest', got \"drop_newest\"");
+}
+
+TEST(GraphLoader, UnknownOverrideTargetSuggestsNode) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({"nodes": {"camera": {"type": "test.counter"}}})");
+  EXPECT_EQ(load_error(file, {{{"camera.count", "3"}, {"camra.count", "3"}, {"nodot", "1"}}, {}}),
+            "command line:--set camra.count: no node named 'camra'; did you mean 'camera'?\n"
+            "command line:--set nodot: expected NODE.PARAM=VALUE");
+}
+
+TEST(GraphLoader, IncludeCycleIsReported) {
+  TempDir dir;
+  dir.write("a.json", R"({"include": ["b.json"]})");
+  dir.write("b.json", R"({"include": ["a.json"]})");
+  const auto a = (dir.path() / "a.json").string();
+  const auto b = (dir.path() / "b.json").string();
+  EXPECT_EQ(load_error(dir.path() / "a.json"),
+            b + ":/include/0/file: include cycle: " + a + " -> " + b + " -> " + a);
+}
+
+TEST(GraphLoader, ParseSettingNeedsEquals) {
+  EXPECT_EQ(parse_setting("--set", "a.b=c=d").value, "c=d");
+  EXPECT_THROW(parse_setting("--set", "a.b"), Error);
+}
+
+}  // namespace
+}  // namespace tilth

@@ -1,0 +1,187 @@
+#include "test_stages.h"
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <random>
+#include <thread>
+
+#include "tilth/stage_descriptor.h"
+
+namespace tilth::testing {
+namespace {
+
+std::mutex logs_mutex;
+std::map<std::string, std::unique_ptr<SinkLog>> logs;
+std::atomic<int> delays_now{0};
+std::atomic<int> delays_max{0};
+
+void note_max(std::atomic<int>& max, int value) {
+  int seen = max.load();
+  while (value > seen && !max.compare_exchange_weak(seen, value)) {
+  }
+}
+
+// Emits 0, 1, 2, ... `count` frames (0: endless); optionally paced.
+class Counter final : public Source {
+ public:
+  explicit Counter(const StageContext& c)
+      : count_(c.params.integer("count")), period_us_(c.params.integer("period_us")) {}
+  bool produce(Frame& frame) override {
+    if (count_ > 0 && next_ >= count_) return false;
+    if (period_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(period_us_));
+    frame.set_capture(static_cast<std::uint64_t>(next_), next_ * 1000, 0);
+    frame.emit(0, Count(next_));
+    ++next_;
+    return true;
+  }
+  void interrupt() override { interrupted_ = true; }
+
+ private:
+  const std::int64_t count_;
+  const std::int64_t period_us_;
+  std::int64_t next_ = 0;
+  std::atomic<bool> interrupted_{false};
+};
+
+// Adds `add`, after sleeping a pseudo-random time below `max_delay_us` (so frames
+// overtake each other in a parallel stage).
+class Delay final : public Transform {
+ public:
+  explicit Delay(const StageContext& c)
+      : add_(c.params.integer("add")), max_delay_us_(c.params.integer("max_delay_us")) {}
+  void process(Frame& frame) override {
+    note_max(delays_max, ++delays_now);
+    const auto value = frame.input<Count>(0).value;
+    if (max_delay_us_ > 0) {
+      std::minstd_rand random(static_cast<std::uint32_t>(value * 7919 + 1));
+      std::this_thread::sleep_for(std::chrono::microseconds(random() % max_delay_us_));
+    }
+    --delays_now;
+    frame.emit(0, Count(value + add_));
+  }
+
+ private:
+  const std::int64_t add_;
+  const std::int64_t max_delay_us_;
+};
+
+class Add final : public Transform {
+ public:
+  explicit Add(const StageContext&) {}
+  void process(Frame& frame) override {
+    frame.emit(0, Count(frame.input<Count>(0).value + frame.input<Count>(1).value));
+  }
+};
+
+// Throws on the frames whose value is a multiple of `every` (0: never), or in its
+// constructor when `fail_to_start` is set.
+class Fail final : public Transform {
+ public:
+  explicit Fail(const StageContext& c) : every_(c.params.integer("every")) {
+    if (c.params.boolean("fail_to_start")) throw Error("camera 'xyz' not found");
+  }
+  void process(Frame& frame) override {
+    const auto value = frame.input<Count>(0).value;
+    if (every_ > 0 && value % every_ == 0) throw Error("bad value " + std::to_string(value));
+    frame.emit(0, Count(value));
+  }
+
+ private:
+  const std::int64_t every_;
+};
+
+class Record final : public Sink {
+ public:
+  explicit Record(const StageContext& c)
+      : log_(sink_log(c.node)), delay_us_(c.params.integer("delay_us")) {}
+  void consume(const Frame& frame) override {
+    note_max(log_.max_concurrent, ++log_.concurrent);
+    if (delay_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(delay_us_));
+    {
+      std::lock_guard lock(log_.mutex);
+      log_.frames.push_back({frame.info(), frame.input<Count>(0).value, false});
+    }
+    --log_.concurrent;
+  }
+  void skipped(const FrameInfo& info) override {
+    std::lock_guard lock(log_.mutex);
+    log_.frames.push_back({info, 0, true});
+  }
+  void finish() override {
+    std::lock_guard lock(log_.mutex);
+    log_.finished = true;
+  }
+
+ private:
+  SinkLog& log_;
+  const std::int64_t delay_us_;
+};
+
+StageDescriptor describe(std::string type, std::vector<PortSpec> inputs,
+                         std::vector<PortSpec> outputs, std::vector<ParamSpec> params,
+                         Concurrency concurrency,
+                         std::function<std::unique_ptr<Stage>(const StageContext&)> create) {
+  StageDescriptor d;
+  d.type = std::move(type);
+  d.summary = "test stage";
+  d.inputs = std::move(inputs);
+  d.outputs = std::move(outputs);
+  d.params = std::move(params);
+  d.concurrency = concurrency;
+  d.create = std::move(create);
+  return d;
+}
+
+}  // namespace
+
+SinkLog& sink_log(const std::string& node) {
+  std::lock_guard lock(logs_mutex);
+  auto& log = logs[node];
+  if (!log) log = std::make_unique<SinkLog>();
+  return *log;
+}
+
+void reset_sink_logs() {
+  std::lock_guard lock(logs_mutex);
+  logs.clear();
+  delays_max = 0;
+}
+
+int max_parallel_delays() { return delays_max.load(); }
+
+void register_test_stages(StageRegistry& registry) {
+  const auto count = [](const char* name) { return PortSpec::of<Count>(name, "a count"); };
+  registry.add(describe("test.counter", {}, {count("out")},
+                        {ParamSpec::integer("count", 10).range(0, std::nullopt).describe("frames"),
+                         ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace")},
+                        Concurrency::kSerial, factory<Counter>()),
+               "test_stages");
+  registry.add(describe("test.delay", {count("in")}, {count("out")},
+                        {ParamSpec::integer("add", 0).describe("added to the value"),
+                         ParamSpec::integer("max_delay_us", 0).range(0, 1'000'000).in_unit("us")
+                             .describe("longest sleep")},
+                        Concurrency::kParallel, factory<Delay>()),
+               "test_stages");
+  registry.add(describe("test.add", {count("a"), count("b")}, {count("sum")}, {},
+                        Concurrency::kParallel, factory<Add>()),
+               "test_stages");
+  registry.add(describe("test.fail", {count("in")}, {count("out")},
+                        {ParamSpec::integer("every", 0).range(0, std::nullopt).describe("period"),
+                         ParamSpec::boolean("fail_to_start", false).describe("throw when made")},
+                        Concurrency::kParallel, factory<Fail>()),
+               "test_stages");
+  registry.add(describe("test.record", {count("in")}, {},
+                        {ParamSpec::integer("delay_us", 0).range(0, std::nullopt).describe("pace"),
+                         ParamSpec::number("gain", 1.0).range(0, 10).in_unit("dB").describe("x"),
+                         ParamSpec::choice("mode", {"fast", "exact"}, "fast").describe("mode"),
+                         ParamSpec::path("file", "record.txt").describe("where to write")},
+                        Concurrency::kSerial, factory<Record>()),
+               "test_stages");
+  registry.add(describe("test.needs_path", {count("in")}, {},
+                        {ParamSpec::path("file", std::nullopt).describe("where to write")},
+                        Concurrency::kSerial, factory<Record>()),
+               "test_stages");
+}
+
+}  // namespace tilth::testing
