@@ -8,6 +8,10 @@ namespace {
 std::string quoted(const std::string& text) {
   std::string escaped = "\"";
   for (char c : text) {
+    if (c == '\n') {
+      escaped += "\\n";
+      continue;
+    }
     if (c == '"' || c == '\\') escaped += '\\';
     escaped += c;
   }
@@ -30,8 +34,9 @@ std::string to_dot(const ValidatedGraph& graph) {
     for (std::size_t p = 0; p < node.inputs.size(); ++p) {
       const auto& from = node.inputs[p];
       const auto& out_port = graph.nodes[from.node].stage->descriptor.outputs[from.port];
-      out << "  n" << from.node << " -> n" << i << " [label="
-          << quoted(out_port.name + " → " + inputs[p].name + "\n" + out_port.type) << "];\n";
+      out << "  n" << from.node << " -> n" << i
+          << " [label=" << quoted(out_port.name + " → " + inputs[p].name + "\n" + out_port.type)
+          << "];\n";
     }
   }
   out << "}\n";

@@ -63,8 +63,9 @@ void FrameAdmission::wait_until_drained() {
 
 FrameAdmission::Batch FrameAdmission::take_admissible_locked() {
   Batch batch;
-  while (!closed_ && in_flight_ < max_in_flight_ &&
-         std::all_of(waiting_.begin(), waiting_.end(), [](const auto& b) { return b != nullptr; })) {
+  while (
+      !closed_ && in_flight_ < max_in_flight_ &&
+      std::all_of(waiting_.begin(), waiting_.end(), [](const auto& b) { return b != nullptr; })) {
     std::vector<std::shared_ptr<Bundle>> frame;
     for (std::size_t s = 0; s < waiting_.size(); ++s) {
       frame.push_back(std::move(waiting_[s]));

@@ -1,9 +1,9 @@
 // Lets frames into a running graph.
 //
-//   source 0 thread --offer--> [waiting 0] --+
-//                                            +--(each source has one, in flight < max)--> admit(seq, ...)
-//   source 1 thread --offer--> [waiting 1] --+                 ^
-//                                            complete() -------+  (a frame left the graph)
+//   source 0 --offer--> [waiting 0] --+
+//                                     +--(all waiting, in flight < max)--> admit(seq, ...)
+//   source 1 --offer--> [waiting 1] --+                ^
+//                                     complete() ------+  (a frame left the graph)
 //
 // A frame is one packet bundle from every source; it gets the next sequence number when
 // it is admitted, so sequence numbers are dense and the same for all sources of a frame

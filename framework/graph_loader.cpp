@@ -24,9 +24,8 @@ namespace {
 using json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables",
-                                                "include",     "nodes",   "edges",
-                                                "runtime"};
+const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables", "include",
+                                                "nodes",       "edges",   "runtime"};
 const std::vector<std::string> kNodeKeys = {"type", "params", "description"};
 const std::vector<std::string> kIncludeKeys = {"file", "as", "variables"};
 const std::vector<std::string> kRuntimeKeys = {"max_in_flight", "when_full", "on_error"};
@@ -58,8 +57,7 @@ std::string scalar_text(const json& value) {
 
 class Loader {
  public:
-  Loader(const GraphOverrides& overrides, Diagnostics& diagnostics)
-      : diagnostics_(diagnostics) {
+  Loader(const GraphOverrides& overrides, Diagnostics& diagnostics) : diagnostics_(diagnostics) {
     for (const auto& variable : overrides.variables) {
       command_line_variables_[variable.key] = parse_value(variable.value);
     }
@@ -131,12 +129,12 @@ class Loader {
       }
       NodeSpec* node = find_node(node_name);
       if (node == nullptr) {
-        diagnostics_.add(where, "no node named '" + node_name + "'" +
-                                    did_you_mean(node_name, node_names()));
+        diagnostics_.add(
+            where, "no node named '" + node_name + "'" + did_you_mean(node_name, node_names()));
         continue;
       }
-      node->params[param] = {nlohmann::json(parse_value(setting.value)), where,
-                             fs::current_path(), setting.value};
+      node->params[param] = {nlohmann::json(parse_value(setting.value)), where, fs::current_path(),
+                             setting.value};
     }
   }
 
@@ -326,8 +324,8 @@ class Loader {
       }
       for (const auto& [param, value] : body["params"].items()) {
         const Location param_where = params_where.child(param);
-        node->params[param] = {nlohmann::json(substitute(value, variables, param_where)),
-                               param_where, dir, {}};
+        node->params[param] = {
+            nlohmann::json(substitute(value, variables, param_where)), param_where, dir, {}};
       }
     }
   }
@@ -357,8 +355,8 @@ class Loader {
                          "expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": ...}");
         continue;
       }
-      graph_.edges.push_back({prefix + from.get<std::string>(), prefix + to.get<std::string>(),
-                              where});
+      graph_.edges.push_back(
+          {prefix + from.get<std::string>(), prefix + to.get<std::string>(), where});
     }
   }
 
@@ -400,8 +398,8 @@ class Loader {
           diagnostics_.add(at, "expected 'skip' or 'stop', got " + value.dump());
         }
       } else if (where.file == "command line") {
-        diagnostics_.add(at, "unknown runtime option '" + key + "'" +
-                                 did_you_mean(key, kRuntimeKeys));
+        diagnostics_.add(at,
+                         "unknown runtime option '" + key + "'" + did_you_mean(key, kRuntimeKeys));
       }
     }
   }

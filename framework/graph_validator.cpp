@@ -104,7 +104,8 @@ class Validator {
       }
       if (param.type == ParamType::kPath) {
         const fs::path path = value.get<std::string>();
-        value = path.is_absolute() ? path.string() : (given.base_dir / path).lexically_normal().string();
+        value = path.is_absolute() ? path.string()
+                                   : (given.base_dir / path).lexically_normal().string();
       }
       values[param.name] = std::move(value);
     }

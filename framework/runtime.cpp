@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -12,6 +13,7 @@
 #include "framework/keyed_join.h"
 #include "framework/latency_histogram.h"
 #include "framework/sequence_reorder.h"
+#include "framework/thread_sanitizer.h"
 #include "tilth/log.h"
 
 namespace tilth {
@@ -41,10 +43,26 @@ struct Node {
   bool ordered = false;
   std::mutex order_mutex;
   SequenceReorder<std::vector<BundlePtr>> reorder;
-  std::unique_ptr<tbb::flow::function_node<BundlePtr>> flow_node;
+  // Bundles travel through this inbox, under its mutex, and the flow graph carries one
+  // token per bundle: the hand-over between threads is then visible to ThreadSanitizer,
+  // which cannot see inside libtbb.
+  std::mutex inbox_mutex;
+  std::deque<BundlePtr> inbox;
+  std::unique_ptr<tbb::flow::function_node<tbb::flow::continue_msg>> flow_node;
   LatencyHistogram latency;
   std::atomic<std::uint64_t> errors{0};
   std::atomic<std::uint64_t> skipped{0};
+
+  void add_delivery(BundlePtr bundle) {
+    std::lock_guard lock(inbox_mutex);
+    inbox.push_back(std::move(bundle));
+  }
+  BundlePtr take_delivery() {
+    std::lock_guard lock(inbox_mutex);
+    BundlePtr bundle = std::move(inbox.front());
+    inbox.pop_front();
+    return bundle;
+  }
 
   const std::string& type() const { return spec.stage->descriptor.type; }
   std::string label() const { return "node '" + spec.name + "' (" + type() + ")"; }
@@ -74,6 +92,7 @@ class Runtime::Impl {
     // This thread works in the flow graph's arena (wait_for_all) until every admitted
     // frame is done; the reservation keeps it there while sources may still admit.
     flow_.reserve_wait();
+    publish_graph_to_workers();
     std::vector<std::thread> threads;
     threads.emplace_back([this] {
       admission_->wait_until_drained();
@@ -168,10 +187,11 @@ class Runtime::Impl {
       if (node.source) continue;
       node.join = std::make_unique<KeyedJoin>(node.predecessors.size());
       node.ordered = node.sink || node.spec.stage->descriptor.concurrency == Concurrency::kSerial;
-      node.flow_node = std::make_unique<tbb::flow::function_node<BundlePtr>>(
+      node.flow_node = std::make_unique<tbb::flow::function_node<tbb::flow::continue_msg>>(
           flow_, node.ordered ? tbb::flow::serial : tbb::flow::unlimited,
-          [this, i](const BundlePtr& bundle) {
-            receive(i, bundle);
+          [this, i](tbb::flow::continue_msg) {
+            acquire_published_graph();
+            receive(i, nodes_[i]->take_delivery());
             return tbb::flow::continue_msg();
           });
     }
@@ -226,7 +246,10 @@ class Runtime::Impl {
       frame_done(bundle->info);
       return;
     }
-    for (std::size_t next : successors) nodes_[next]->flow_node->try_put(bundle);
+    for (std::size_t next : successors) {
+      nodes_[next]->add_delivery(bundle);
+      nodes_[next]->flow_node->try_put(tbb::flow::continue_msg());
+    }
   }
 
   void receive(std::size_t index, const BundlePtr& bundle) {

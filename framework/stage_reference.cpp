@@ -41,9 +41,9 @@ std::string stage_line(const StageRegistry::Entry& entry) {
 std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
   const auto& d = entry.descriptor;
   std::ostringstream out;
-  const std::string concurrency =
-      d.concurrency == Concurrency::kSerial ? "serial (stateful, frames in order)"
-                                            : "parallel (stateless, frames concurrently)";
+  const std::string concurrency = d.concurrency == Concurrency::kSerial
+                                      ? "serial (stateful, frames in order)"
+                                      : "parallel (stateless, frames concurrently)";
   if (markdown) {
     out << "## `" << d.type << "`\n\n" << d.summary << "\n\n";
     out << "Kind: " << to_string(d.kind()) << ", " << concurrency << ". Plugin: `" << entry.plugin
@@ -60,8 +60,8 @@ std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
       out << "| parameter | type | default | allowed | unit | description |\n";
       out << "|---|---|---|---|---|---|\n";
       for (const auto& p : d.params) {
-        out << "| `" << p.name << "` | " << to_string(p.type) << " | `" << default_text(p)
-            << "` | " << allowed_text(p) << " | " << p.unit << " | " << p.description << " |\n";
+        out << "| `" << p.name << "` | " << to_string(p.type) << " | `" << default_text(p) << "` | "
+            << allowed_text(p) << " | " << p.unit << " | " << p.description << " |\n";
       }
       out << "\n";
     }

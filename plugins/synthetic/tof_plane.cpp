@@ -81,25 +81,37 @@ StageDescriptor describe() {
   d.summary = "raw ToF frames of flat soil at a known distance (paper eq. 1 inverted)";
   d.outputs = {PortSpec::of<RawTofFrame>("raw", "16-bit gray, radial distance / gray_to_mm")};
   d.params = {
-      ParamSpec::number("distance_mm", 518.0).range(50, 5000).in_unit("mm").describe(
-          "mounting surface to the plane, along the optical axis"),
-      ParamSpec::number("noise_mm", 1.0).range(0, 100).in_unit("mm").describe(
-          "standard deviation of the range noise"),
-      ParamSpec::integer("frames", 0).range(0, std::nullopt).describe(
-          "frames to produce; 0 = endless"),
-      ParamSpec::number("fps", 30.0).range(0, 1000).in_unit("1/s").describe(
-          "frame rate; 0 = as fast as possible"),
+      ParamSpec::number("distance_mm", 518.0)
+          .range(50, 5000)
+          .in_unit("mm")
+          .describe("mounting surface to the plane, along the optical axis"),
+      ParamSpec::number("noise_mm", 1.0)
+          .range(0, 100)
+          .in_unit("mm")
+          .describe("standard deviation of the range noise"),
+      ParamSpec::integer("frames", 0)
+          .range(0, std::nullopt)
+          .describe("frames to produce; 0 = endless"),
+      ParamSpec::number("fps", 30.0)
+          .range(0, 1000)
+          .in_unit("1/s")
+          .describe("frame rate; 0 = as fast as possible"),
       ParamSpec::integer("seed", 1).range(0, std::nullopt).describe("noise seed"),
       ParamSpec::integer("width", 640).range(1, 8192).in_unit("px").describe("image width"),
       ParamSpec::integer("height", 480).range(1, 8192).in_unit("px").describe("image height"),
-      ParamSpec::number("focal_px", 509.935).range(1, std::nullopt).in_unit("px").describe(
-          "focal length"),
+      ParamSpec::number("focal_px", 509.935)
+          .range(1, std::nullopt)
+          .in_unit("px")
+          .describe("focal length"),
       ParamSpec::number("cx", 313.05).in_unit("px").describe("principal point, x"),
       ParamSpec::number("cy", 239.60).in_unit("px").describe("principal point, y"),
-      ParamSpec::number("gray_to_mm", 0.0229).range(1e-6, std::nullopt).in_unit("mm").describe(
-          "millimetres per gray value (the paper's mu)"),
-      ParamSpec::number("z_offset_mm", 23.97).in_unit("mm").describe(
-          "optical centre behind the mounting surface"),
+      ParamSpec::number("gray_to_mm", 0.0229)
+          .range(1e-6, std::nullopt)
+          .in_unit("mm")
+          .describe("millimetres per gray value (the paper's mu)"),
+      ParamSpec::number("z_offset_mm", 23.97)
+          .in_unit("mm")
+          .describe("optical centre behind the mounting surface"),
   };
   d.concurrency = Concurrency::kSerial;
   d.create = factory<TofPlane>();

@@ -16,9 +16,7 @@ const nlohmann::json& Params::json(std::string_view name) const {
 }
 
 bool Params::boolean(std::string_view name) const { return json(name).get<bool>(); }
-std::int64_t Params::integer(std::string_view name) const {
-  return json(name).get<std::int64_t>();
-}
+std::int64_t Params::integer(std::string_view name) const { return json(name).get<std::int64_t>(); }
 double Params::number(std::string_view name) const { return json(name).get<double>(); }
 std::string Params::string(std::string_view name) const { return json(name).get<std::string>(); }
 std::filesystem::path Params::path(std::string_view name) const {

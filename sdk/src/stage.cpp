@@ -1,5 +1,5 @@
-#include "tilth/frame.h"
 #include "tilth/stage.h"
+#include "tilth/frame.h"
 #include "tilth/stage_descriptor.h"
 
 namespace tilth {

@@ -25,10 +25,11 @@ std::shared_ptr<Bundle> bundle_for(std::size_t node, std::uint64_t frame_id) {
 
 TEST(FrameAdmission, AssemblesOneBundlePerSourceWithDenseSequences) {
   std::vector<std::pair<std::uint64_t, std::vector<std::uint64_t>>> admitted;
-  FrameAdmission admission(2, 10, FullPolicy::kBlock,
-                           [&](std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> b) {
-                             admitted.push_back({sequence, {b[0]->info.frame_id, b[1]->info.frame_id}});
-                           });
+  FrameAdmission admission(
+      2, 10, FullPolicy::kBlock,
+      [&](std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> b) {
+        admitted.push_back({sequence, {b[0]->info.frame_id, b[1]->info.frame_id}});
+      });
   EXPECT_TRUE(admission.offer(0, bundle_for(0, 10)));
   EXPECT_TRUE(admitted.empty());  // waits for source 1
   EXPECT_TRUE(admission.offer(1, bundle_for(1, 20)));
@@ -55,8 +56,9 @@ TEST(FrameAdmission, DropOldestKeepsTheNewestWaitingFrame) {
 
 TEST(FrameAdmission, BlockHoldsTheSourceUntilAFrameCompletes) {
   std::atomic<int> admitted{0};
-  FrameAdmission admission(1, 1, FullPolicy::kBlock,
-                           [&](std::uint64_t, std::vector<std::shared_ptr<Bundle>>) { ++admitted; });
+  FrameAdmission admission(
+      1, 1, FullPolicy::kBlock,
+      [&](std::uint64_t, std::vector<std::shared_ptr<Bundle>>) { ++admitted; });
   std::atomic<int> offered{0};
   std::thread source([&] {
     for (int i = 0; i < 3; ++i) {
@@ -77,8 +79,9 @@ TEST(FrameAdmission, BlockHoldsTheSourceUntilAFrameCompletes) {
 
 TEST(FrameAdmission, EndOfStreamAdmitsWhatWaitsThenCloses) {
   int admitted = 0;
-  FrameAdmission admission(1, 1, FullPolicy::kBlock,
-                           [&](std::uint64_t, std::vector<std::shared_ptr<Bundle>>) { ++admitted; });
+  FrameAdmission admission(
+      1, 1, FullPolicy::kBlock,
+      [&](std::uint64_t, std::vector<std::shared_ptr<Bundle>>) { ++admitted; });
   admission.offer(0, bundle_for(0, 0));
   admission.offer(0, bundle_for(0, 1));
   admission.end_of_stream(0);

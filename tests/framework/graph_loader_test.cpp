@@ -53,7 +53,8 @@ TEST(GraphLoader, ReadsNodesEdgesAndRuntime) {
 
 TEST(GraphLoader, MalformedJsonGivesLineAndColumn) {
   TempDir dir;
-  const auto file = dir.write("bad.json", "{\n  \"nodes\": {\n    \"a\": {\"type\": \"x\",}\n  }\n}\n");
+  const auto file =
+      dir.write("bad.json", "{\n  \"nodes\": {\n    \"a\": {\"type\": \"x\",}\n  }\n}\n");
   EXPECT_EQ(load_error(file),
             file.string() +
                 ":3:23: malformed JSON: syntax error while parsing object key - unexpected '}'; "
@@ -61,8 +62,9 @@ TEST(GraphLoader, MalformedJsonGivesLineAndColumn) {
 }
 
 TEST(GraphLoader, MissingFileIsReported) {
-  EXPECT_EQ(load_error("/nonexistent/g.json"), "/nonexistent/g.json: cannot read graph file "
-                                               "'/nonexistent/g.json'");
+  EXPECT_EQ(load_error("/nonexistent/g.json"),
+            "/nonexistent/g.json: cannot read graph file "
+            "'/nonexistent/g.json'");
 }
 
 TEST(GraphLoader, IncludesAreNamespacedAndOverridable) {
@@ -137,13 +139,15 @@ TEST(GraphLoader, ReportsEveryProblemAtOnce) {
   })");
   const std::string f = file.string();
   EXPECT_EQ(load_error(file),
-            f + ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
+            f +
+                ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
                 "of 'description', 'plugins', 'variables', 'include', 'nodes', 'edges', "
                 "'runtime')\n" +
                 f + ":/nodes/a/params/count: unknown variable 'missing' (defined: none)\n" + f +
                 ":/nodes/b: node 'b' has no \"type\" and overrides no included node; did you mean "
-                "'a'?\n" + f +
-                ":/nodes/c.d: node names must be non-empty, without '.', and not 'runtime'\n" + f +
+                "'a'?\n" +
+                f + ":/nodes/c.d: node names must be non-empty, without '.', and not 'runtime'\n" +
+                f +
                 ":/edges/0: expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": "
                 "...}\n" +
                 f + ":/runtime/when_full: expected 'block' or 'drop_oldest', got \"drop_newest\"");

@@ -64,8 +64,9 @@ TEST_F(GraphValidatorTest, AcceptsAGoodGraphInTopologicalOrder) {
 
 TEST_F(GraphValidatorTest, UnknownStageTypeSuggestsNearestNames) {
   EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.countr"}}})"),
-            at("/nodes/src/type") + ": unknown stage type 'test.countr'; did you mean "
-                                    "'test.counter'?\n" +
+            at("/nodes/src/type") +
+                ": unknown stage type 'test.countr'; did you mean "
+                "'test.counter'?\n" +
                 file_.string() + ": the graph has no source stage");
   EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.counter"}, "x": {"type": "zzz"}}})"),
             at("/nodes/x/type") +
@@ -75,8 +76,9 @@ TEST_F(GraphValidatorTest, UnknownStageTypeSuggestsNearestNames) {
 TEST_F(GraphValidatorTest, UnknownPortListsThePorts) {
   EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.counter"}, "out": {"type": "test.record"}},
                        "edges": [["src.ot", "out.in"]]})"),
-            at("/edges/0") + ": node 'src' (test.counter) has no output port 'ot'; did you mean "
-                             "'out'?; its outputs: 'out'\n" +
+            at("/edges/0") +
+                ": node 'src' (test.counter) has no output port 'ot'; did you mean "
+                "'out'?; its outputs: 'out'\n" +
                 at("/nodes/out") + ": input 'in' (test.Count) is not connected");
 }
 
@@ -91,8 +93,9 @@ TEST_F(GraphValidatorTest, EdgeEndpointsAreChecked) {
 TEST_F(GraphValidatorTest, TypeMismatchOnAnEdge) {
   EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.counter"}, "d": {"type": "test.depth_sink"}},
                        "edges": [["src.out", "d.depth"]]})"),
-            at("/edges/0") + ": type mismatch: src.out carries test.Count but d.depth expects "
-                             "tilth.DepthImage\n" +
+            at("/edges/0") +
+                ": type mismatch: src.out carries test.Count but d.depth expects "
+                "tilth.DepthImage\n" +
                 at("/nodes/d") + ": input 'depth' (tilth.DepthImage) is not connected");
 }
 
@@ -121,11 +124,15 @@ TEST_F(GraphValidatorTest, ParametersAreChecked) {
       at("/nodes/src/params/cont") +
           ": unknown parameter 'cont' of test.counter; did you mean 'count'? (its parameters: "
           "'count', 'period_us')\n" +
-          at("/nodes/src/params/period_us") + ": parameter 'period_us': expected an integer >= 0, got -1\n" +
-          at("/nodes/out/params/delay_us") + ": parameter 'delay_us': expected an integer >= 0, got 1.5\n" +
-          at("/nodes/out/params/gain") + ": parameter 'gain': expected a number in [0, 10], got 11\n" +
-          at("/nodes/out/params/mode") + ": parameter 'mode': expected one of 'fast', 'exact', got \"slow\"\n" +
-          at("/nodes/p") + ": missing required parameter 'file' (path: where to write)");
+          at("/nodes/src/params/period_us") +
+          ": parameter 'period_us': expected an integer >= 0, got -1\n" +
+          at("/nodes/out/params/delay_us") +
+          ": parameter 'delay_us': expected an integer >= 0, got 1.5\n" +
+          at("/nodes/out/params/gain") +
+          ": parameter 'gain': expected a number in [0, 10], got 11\n" +
+          at("/nodes/out/params/mode") +
+          ": parameter 'mode': expected one of 'fast', 'exact', got \"slow\"\n" + at("/nodes/p") +
+          ": missing required parameter 'file' (path: where to write)");
 }
 
 TEST_F(GraphValidatorTest, CommandLineValuesTakeTheParameterType) {
@@ -141,9 +148,9 @@ TEST_F(GraphValidatorTest, CommandLineValuesTakeTheParameterType) {
   EXPECT_EQ(graph.nodes[1].params.path("file"), std::filesystem::current_path() / "123");
   EXPECT_EQ(graph.nodes[0].params.integer("count"), 4);
 
-  EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.counter"}}})",
-                   {{{"src.count", "many"}}, {}}),
-            "command line:--set src.count: parameter 'count': expected an integer >= 0, got \"many\"");
+  EXPECT_EQ(
+      errors(R"({"nodes": {"src": {"type": "test.counter"}}})", {{{"src.count", "many"}}, {}}),
+      "command line:--set src.count: parameter 'count': expected an integer >= 0, got \"many\"");
 }
 
 }  // namespace

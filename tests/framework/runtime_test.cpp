@@ -106,7 +106,8 @@ TEST_F(RuntimeTest, BlockPolicyLosesNothing) {
       "nodes": {"src": {"type": "test.counter", "params": {"count": 100}},
                 "out": {"type": "test.record", "params": {"delay_us": 200}}},
       "edges": [["src.out", "out.in"]],
-      "runtime": {"max_in_flight": )" + std::to_string(limit) + R"(, "when_full": "block"}
+      "runtime": {"max_in_flight": )" +
+                                 std::to_string(limit) + R"(, "when_full": "block"}
     })");
     EXPECT_EQ(values("out"), range(100)) << "max_in_flight " << limit;
     EXPECT_EQ(result.metrics.frames_dropped, 0u);
@@ -199,7 +200,8 @@ TEST_F(RuntimeTest, FrameLimit) {
     "nodes": {"src": {"type": "test.counter", "params": {"count": 0}},
               "out": {"type": "test.record"}},
     "edges": [["src.out", "out.in"]]
-  })", RunLimits{25});
+  })",
+                               RunLimits{25});
   EXPECT_EQ(values("out"), range(25));
   EXPECT_EQ(result.metrics.frames_completed, 25u);
 }

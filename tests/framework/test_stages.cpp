@@ -120,8 +120,7 @@ class Record final : public Sink {
 
 StageDescriptor describe(std::string type, std::vector<PortSpec> inputs,
                          std::vector<PortSpec> outputs, std::vector<ParamSpec> params,
-                         Concurrency concurrency,
-                         std::function<std::unique_ptr<Stage>(const StageContext&)> create) {
+                         Concurrency concurrency, StageFactory create) {
   StageDescriptor d;
   d.type = std::move(type);
   d.summary = "test stage";
@@ -152,14 +151,17 @@ int max_parallel_delays() { return delays_max.load(); }
 
 void register_test_stages(StageRegistry& registry) {
   const auto count = [](const char* name) { return PortSpec::of<Count>(name, "a count"); };
-  registry.add(describe("test.counter", {}, {count("out")},
-                        {ParamSpec::integer("count", 10).range(0, std::nullopt).describe("frames"),
-                         ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace")},
-                        Concurrency::kSerial, factory<Counter>()),
-               "test_stages");
+  registry.add(
+      describe("test.counter", {}, {count("out")},
+               {ParamSpec::integer("count", 10).range(0, std::nullopt).describe("frames"),
+                ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace")},
+               Concurrency::kSerial, factory<Counter>()),
+      "test_stages");
   registry.add(describe("test.delay", {count("in")}, {count("out")},
                         {ParamSpec::integer("add", 0).describe("added to the value"),
-                         ParamSpec::integer("max_delay_us", 0).range(0, 1'000'000).in_unit("us")
+                         ParamSpec::integer("max_delay_us", 0)
+                             .range(0, 1'000'000)
+                             .in_unit("us")
                              .describe("longest sleep")},
                         Concurrency::kParallel, factory<Delay>()),
                "test_stages");

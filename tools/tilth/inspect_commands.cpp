@@ -24,7 +24,8 @@ bool wants_help(const CommandLine& line, const char* usage) {
 
 GraphOverrides graph_overrides(const CommandLine& line) {
   GraphOverrides overrides;
-  for (const auto& text : line.values("--set")) overrides.params.push_back(parse_setting("--set", text));
+  for (const auto& text : line.values("--set"))
+    overrides.params.push_back(parse_setting("--set", text));
   for (const auto& text : line.values("--var")) {
     overrides.variables.push_back(parse_setting("--var", text));
   }
@@ -33,10 +34,12 @@ GraphOverrides graph_overrides(const CommandLine& line) {
 
 int validate_command(int argc, char** argv) {
   const CommandLine line(argc, argv, 2, kGraphOptions, {"--help"});
-  const std::string usage = std::string("usage: tilth validate GRAPH [--set NODE.PARAM=VALUE]... [--var NAME=VALUE]...\n\n"
-                            "Checks a graph file, its includes and parameters against the stage types and\n"
-                            "prints every problem with its file and JSON pointer. Exit code 0 when valid.\n\n") +
-                            kGraphOptionsHelp;
+  const std::string usage =
+      std::string(
+          "usage: tilth validate GRAPH [--set NODE.PARAM=VALUE]... [--var NAME=VALUE]...\n\n"
+          "Checks a graph file, its includes and parameters against the stage types and\n"
+          "prints every problem with its file and JSON pointer. Exit code 0 when valid.\n\n") +
+      kGraphOptionsHelp;
   if (wants_help(line, usage.c_str())) return kExitOk;
   if (line.positional().size() != 1) {
     std::cerr << usage;
@@ -44,8 +47,7 @@ int validate_command(int argc, char** argv) {
   }
   try {
     const auto session = open_graph(line.positional()[0], graph_overrides(line));
-    std::cout << line.positional()[0] << ": valid, " << session.graph.nodes.size()
-              << " nodes\n";
+    std::cout << line.positional()[0] << ": valid, " << session.graph.nodes.size() << " nodes\n";
     return kExitOk;
   } catch (const GraphError& error) {
     std::cerr << error.what() << "\n";
@@ -97,8 +99,9 @@ int describe_command(int argc, char** argv) {
 int dot_command(int argc, char** argv) {
   const CommandLine line(argc, argv, 2, kGraphOptions, {"--help"});
   const std::string usage =
-      std::string("usage: tilth dot GRAPH [--set ...] [--var ...]\n\nPrints the graph as Graphviz dot "
-                  "(tilth dot g.json | dot -Tsvg > g.svg).\n\n") +
+      std::string(
+          "usage: tilth dot GRAPH [--set ...] [--var ...]\n\nPrints the graph as Graphviz dot "
+          "(tilth dot g.json | dot -Tsvg > g.svg).\n\n") +
       kGraphOptionsHelp;
   if (wants_help(line, usage.c_str())) return kExitOk;
   if (line.positional().size() != 1) {

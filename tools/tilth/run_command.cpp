@@ -18,12 +18,13 @@
 namespace tilth::cli {
 namespace {
 
-const std::string kUsage = std::string(
-    "usage: tilth run GRAPH [--set NODE.PARAM=VALUE]... [--var NAME=VALUE]... [--frames N]\n"
-    "                 [--quiet] [--verbose]\n\n"
-    "Runs a graph. Ctrl-C (SIGINT) or SIGTERM stops it cleanly: frames in flight\n"
-    "finish and sinks flush; a second Ctrl-C exits at once. At the end each stage's\n"
-    "latency and the graph's frame rate are printed.\n\n") +
+const std::string kUsage =
+    std::string(
+        "usage: tilth run GRAPH [--set NODE.PARAM=VALUE]... [--var NAME=VALUE]... [--frames N]\n"
+        "                 [--quiet] [--verbose]\n\n"
+        "Runs a graph. Ctrl-C (SIGINT) or SIGTERM stops it cleanly: frames in flight\n"
+        "finish and sinks flush; a second Ctrl-C exits at once. At the end each stage's\n"
+        "latency and the graph's frame rate are printed.\n\n") +
     kGraphOptionsHelp +
     "  --frames N              stop after N frames\n"
     "  --quiet                 no status line and no summary\n"

@@ -21,8 +21,8 @@ std::string status_text(const PipelineMetrics& metrics) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(1) << "frames " << metrics.frames_completed << "  fps "
       << metrics.frames_per_second << "  dropped " << metrics.frames_dropped << "  skipped "
-      << total_skipped(metrics) << "  in flight " << metrics.frames_in_flight
-      << "  latency p50 " << metrics.end_to_end.p50_ms << " ms";
+      << total_skipped(metrics) << "  in flight " << metrics.frames_in_flight << "  latency p50 "
+      << metrics.end_to_end.p50_ms << " ms";
   return out.str();
 }
 

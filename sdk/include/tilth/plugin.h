@@ -35,22 +35,22 @@ struct StageRegistration {
 }  // namespace detail
 }  // namespace tilth
 
-#define TILTH_PLUGIN(plugin_name)                                                     \
+#define TILTH_PLUGIN(plugin_name)                                                    \
   __attribute__((visibility("hidden"))) std::vector<::tilth::StageDescriptor>&       \
-  tilth::detail::plugin_stages() {                                                    \
-    static std::vector<::tilth::StageDescriptor> stages;                              \
-    return stages;                                                                    \
-  }                                                                                   \
+  tilth::detail::plugin_stages() {                                                   \
+    static std::vector<::tilth::StageDescriptor> stages;                             \
+    return stages;                                                                   \
+  }                                                                                  \
   extern "C" __attribute__((visibility("default"))) const ::tilth::PluginDescriptor* \
-  tilth_plugin_descriptor() {                                                         \
-    static const ::tilth::PluginDescriptor descriptor{                                \
-        ::tilth::kAbiVersion, sizeof(::tilth::PluginDescriptor), plugin_name,         \
-        &::tilth::detail::plugin_stages()};                                           \
-    return &descriptor;                                                               \
+  tilth_plugin_descriptor() {                                                        \
+    static const ::tilth::PluginDescriptor descriptor{                               \
+        ::tilth::kAbiVersion, sizeof(::tilth::PluginDescriptor), plugin_name,        \
+        &::tilth::detail::plugin_stages()};                                          \
+    return &descriptor;                                                              \
   }
 
 #define TILTH_STAGE_CONCAT_(a, b) a##b
 #define TILTH_STAGE_CONCAT(a, b) TILTH_STAGE_CONCAT_(a, b)
-#define TILTH_STAGE(descriptor_expression)                                                \
-  static const ::tilth::detail::StageRegistration TILTH_STAGE_CONCAT(tilth_stage_, __LINE__)( \
-      descriptor_expression)
+#define TILTH_STAGE(descriptor_expression)                            \
+  static const ::tilth::detail::StageRegistration TILTH_STAGE_CONCAT( \
+      tilth_stage_, __LINE__)(descriptor_expression)

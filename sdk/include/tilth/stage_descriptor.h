@@ -20,6 +20,7 @@ enum class Concurrency {
 };
 
 enum class StageKind { kSource, kTransform, kSink };
+using StageFactory = std::function<std::unique_ptr<Stage>(const StageContext&)>;
 std::string_view to_string(StageKind kind);
 
 struct StageDescriptor {
@@ -29,14 +30,14 @@ struct StageDescriptor {
   std::vector<PortSpec> outputs;
   std::vector<ParamSpec> params;
   Concurrency concurrency = Concurrency::kSerial;
-  std::function<std::unique_ptr<Stage>(const StageContext&)> create;
+  StageFactory create;
 
   StageKind kind() const;
   const ParamSpec* param(std::string_view name) const;
 };
 
 template <class T>
-std::function<std::unique_ptr<Stage>(const StageContext&)> factory() {
+StageFactory factory() {
   return [](const StageContext& context) { return std::make_unique<T>(context); };
 }
 

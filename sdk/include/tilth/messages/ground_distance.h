@@ -18,8 +18,8 @@ struct GroundDistance : MessageOf<GroundDistance> {
   std::string invalid_reason;
   double soil_fraction = 0.0;  // visible soil pixels / pixels in the region of interest
   std::int64_t soil_pixels = 0;
-  double spread_mm = 0.0;   // robust spread of the soil depths
-  double confidence = 0.0;  // 0..1
+  double spread_mm = 0.0;            // robust spread of the soil depths
+  double confidence = 0.0;           // 0..1
   std::optional<double> tilt_x_deg;  // ground tilt, when a plane was fitted
   std::optional<double> tilt_y_deg;
 
