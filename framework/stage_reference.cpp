@@ -17,8 +17,11 @@ std::string ports_text(const std::vector<PortSpec>& ports) {
 std::string allowed_text(const ParamSpec& spec) {
   std::ostringstream out;
   if (spec.min || spec.max) {
-    out << "[" << (spec.min ? std::to_string(*spec.min) : std::string("-inf")) << ", "
-        << (spec.max ? std::to_string(*spec.max) : std::string("inf")) << "]";
+    out << "[";
+    spec.min ? out << *spec.min : out << "-inf";
+    out << ", ";
+    spec.max ? out << *spec.max : out << "inf";
+    out << "]";
   }
   for (std::size_t i = 0; i < spec.choices.size(); ++i) {
     out << (i ? " | " : "") << spec.choices[i];
