@@ -32,7 +32,8 @@ std::string to_dot(const ValidatedGraph& graph) {
     const auto& node = graph.nodes[i];
     const auto& inputs = node.stage->descriptor.inputs;
     for (std::size_t p = 0; p < node.inputs.size(); ++p) {
-      const auto& from = node.inputs[p];
+      if (!node.inputs[p]) continue;
+      const auto& from = *node.inputs[p];
       const auto& out_port = graph.nodes[from.node].stage->descriptor.outputs[from.port];
       out << "  n" << from.node << " -> n" << i
           << " [label=" << quoted(out_port.name + " → " + inputs[p].name + "\n" + out_port.type)

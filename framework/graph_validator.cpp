@@ -173,11 +173,19 @@ class Validator {
     for (std::size_t i = 0; i < nodes_.size(); ++i) {
       if (nodes_[i].stage == nullptr) continue;
       const auto& ports = nodes_[i].stage->descriptor.inputs;
+      bool any_connected = false;
       for (std::size_t p = 0; p < ports.size(); ++p) {
-        if (!inputs_[i][p]) {
+        any_connected = any_connected || inputs_[i][p];
+        if (!inputs_[i][p] && ports[p].required) {
           diagnostics_.add(nodes_[i].where, "input '" + ports[p].name + "' (" + ports[p].type +
                                                 ") is not connected");
         }
+      }
+      if (!ports.empty() && !any_connected &&
+          std::all_of(ports.begin(), ports.end(),
+                      [](const auto& port) { return !port.required; })) {
+        diagnostics_.add(nodes_[i].where,
+                         "none of its inputs is connected (it needs at least one)");
       }
     }
   }
@@ -246,13 +254,17 @@ class Validator {
     for (std::size_t original : order) {
       ResolvedNode node = std::move(nodes_[original]);
       for (const auto& feed : inputs_[original]) {
-        node.inputs.push_back({position[feed->binding.node], feed->binding.port});
+        node.inputs.push_back(feed ? std::optional<InputBinding>(InputBinding{
+                                         position[feed->binding.node], feed->binding.port})
+                                   : std::nullopt);
       }
       result.nodes.push_back(std::move(node));
     }
     for (std::size_t i = 0; i < result.nodes.size(); ++i) {
       std::set<std::size_t> before;
-      for (const auto& input : result.nodes[i].inputs) before.insert(input.node);
+      for (const auto& input : result.nodes[i].inputs) {
+        if (input) before.insert(input->node);
+      }
       for (std::size_t p : before) result.nodes[p].successors.push_back(i);
     }
     return result;

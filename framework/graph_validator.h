@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,8 +23,8 @@ struct ResolvedNode {
   const StageRegistry::Entry* stage;
   Params params;
   Location where;
-  std::vector<InputBinding> inputs;     // one per input port, in port order
-  std::vector<std::size_t> successors;  // distinct, ascending
+  std::vector<std::optional<InputBinding>> inputs;  // per input port; none: optional, unconnected
+  std::vector<std::size_t> successors;              // distinct, ascending
 };
 
 struct ValidatedGraph {

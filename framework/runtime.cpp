@@ -5,6 +5,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <oneapi/tbb/flow_graph.h>
@@ -37,8 +38,10 @@ struct Node {
   Source* source = nullptr;
   Transform* transform = nullptr;
   Sink* sink = nullptr;
-  std::vector<std::size_t> predecessors;                      // distinct node indices
-  std::vector<std::pair<std::size_t, std::size_t>> input_of;  // per input port: (slot, port)
+  std::vector<std::size_t> predecessors;  // distinct node indices
+  // Per input port: (predecessor slot, its output port), or none for an unconnected
+  // optional input.
+  std::vector<std::optional<std::pair<std::size_t, std::size_t>>> input_of;
   std::unique_ptr<KeyedJoin> join;
   bool ordered = false;
   std::mutex order_mutex;
@@ -177,12 +180,17 @@ class Runtime::Impl {
       if (node.source) sources_.push_back(i);
       if (node.spec.successors.empty()) ++terminal_count_;
       for (const auto& input : node.spec.inputs) {
-        auto slot = std::find(node.predecessors.begin(), node.predecessors.end(), input.node);
+        if (!input) {
+          node.input_of.emplace_back();
+          continue;
+        }
+        auto slot = std::find(node.predecessors.begin(), node.predecessors.end(), input->node);
         if (slot == node.predecessors.end()) {
-          node.predecessors.push_back(input.node);
+          node.predecessors.push_back(input->node);
           slot = node.predecessors.end() - 1;
         }
-        node.input_of.emplace_back(slot - node.predecessors.begin(), input.port);
+        node.input_of.emplace_back(
+            std::pair<std::size_t, std::size_t>(slot - node.predecessors.begin(), input->port));
       }
       if (node.source) continue;
       node.join = std::make_unique<KeyedJoin>(node.predecessors.size());
@@ -272,11 +280,13 @@ class Runtime::Impl {
   void execute(std::size_t index, const std::vector<BundlePtr>& arrived) {
     Node& node = *nodes_[index];
     const FrameInfo info = arrived.front()->info;
+    const auto& ports = node.spec.stage->descriptor.inputs;
     std::vector<Packet> inputs;
     bool missing = false;
-    for (const auto& [slot, port] : node.input_of) {
-      inputs.push_back(arrived[slot]->outputs[port]);
-      missing = missing || inputs.back().empty();
+    for (std::size_t p = 0; p < node.input_of.size(); ++p) {
+      const auto& from = node.input_of[p];
+      inputs.push_back(from ? arrived[from->first]->outputs[from->second] : Packet{});
+      missing = missing || (ports[p].required && inputs.back().empty());
     }
     auto result = std::make_shared<Bundle>();
     result->node = index;

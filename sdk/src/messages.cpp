@@ -9,8 +9,10 @@
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
+#include "tilth/messages/ground_truth.h"
 #include "tilth/messages/pipeline_metrics.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/messages/registered_color.h"
 #include "tilth/messages/residue_mask.h"
 
 namespace tilth {
@@ -74,6 +76,11 @@ std::string ColorImage::summary() const {
   return "colour " + size_of(pixels) + " " + std::string(to_string(format));
 }
 
+std::string RegisteredColor::summary() const {
+  const int valid = status.empty() ? 0 : cv::countNonZero(status == kValid);
+  return "registered colour " + size_of(bgr) + ", " + std::to_string(valid) + " valid px";
+}
+
 std::string ResidueMask::summary() const {
   const int total = values.rows * values.cols;
   const int residue = total == 0 ? 0 : cv::countNonZero(values == kResidue);
@@ -90,6 +97,20 @@ std::string GroundDistance::summary() const {
     out << "invalid (" << invalid_reason << ")";
   }
   out << ", soil " << soil_fraction * 100.0 << " %, confidence " << confidence;
+  return out.str();
+}
+
+std::string GroundTruth::summary() const {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(2);
+  out << "truth ";
+  if (distance_mm) {
+    out << *distance_mm << " mm";
+  } else {
+    out << "distance unknown";
+  }
+  if (!residue_mask.empty()) out << ", mask " << size_of(residue_mask);
   return out.str();
 }
 

@@ -56,8 +56,8 @@ TEST_F(GraphValidatorTest, AcceptsAGoodGraphInTopologicalOrder) {
   for (const auto& node : graph.nodes) order.push_back(node.name);
   EXPECT_EQ(order, (std::vector<std::string>{"src", "d", "sum", "out"}));
   EXPECT_EQ(graph.nodes[0].successors, (std::vector<std::size_t>{1, 2}));
-  EXPECT_EQ(graph.nodes[2].inputs[0].node, 0u);
-  EXPECT_EQ(graph.nodes[2].inputs[1].node, 1u);
+  EXPECT_EQ(graph.nodes[2].inputs[0]->node, 0u);
+  EXPECT_EQ(graph.nodes[2].inputs[1]->node, 1u);
   EXPECT_EQ(graph.nodes[0].params.integer("count"), 3);
   EXPECT_EQ(graph.nodes[3].params.string("mode"), "fast");  // the default
 }

@@ -1,6 +1,6 @@
 // The runtime under concurrency: joining by frame, frame order at stateful stages and
 // sinks, bounded frames in flight with both full-pipeline policies, errors, stop.
-// Run under ThreadSanitizer by the tsan preset (label "concurrency").
+// Run under ThreadSanitizer by the tsan preset.
 #include "framework/runtime.h"
 
 #include <chrono>
@@ -181,14 +181,22 @@ TEST_F(RuntimeTest, StopFinishesFramesInFlight) {
     "runtime": {"max_in_flight": 8}
   })");
   std::thread stopper([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    // Stop mid-stream: once 20 frames have reached the sink.
+    auto& log = sink_log("out");
+    for (;;) {
+      {
+        std::lock_guard lock(log.mutex);
+        if (log.frames.size() >= 20) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     runtime->stop();
   });
   const RunResult result = runtime->run();
   stopper.join();
   EXPECT_FALSE(result.failed);
   const auto seen = values("out");
-  EXPECT_GT(seen.size(), 10u);
+  EXPECT_GE(seen.size(), 20u);
   EXPECT_EQ(seen, range(static_cast<std::int64_t>(seen.size())));  // nothing lost
   EXPECT_EQ(result.metrics.frames_admitted, seen.size());
   EXPECT_EQ(result.metrics.frames_in_flight, 0u);

@@ -13,13 +13,22 @@ struct PortSpec {
   std::string name;
   std::string type;  // a message type name
   std::string description;
+  // An optional input may be left unconnected, and the stage still runs when it has no
+  // data for a frame (its packet is then empty). Required inputs must be connected, and
+  // a frame without data on one skips the stage.
+  bool required = true;
 
   template <class T>
   static PortSpec of(std::string name, std::string description) {
-    return {std::move(name), std::string(T::kTypeName), std::move(description)};
+    return {std::move(name), std::string(T::kTypeName), std::move(description), true};
   }
   static PortSpec any(std::string name, std::string description) {
-    return {std::move(name), std::string(kAnyType), std::move(description)};
+    return {std::move(name), std::string(kAnyType), std::move(description), true};
+  }
+
+  PortSpec& optional() {
+    required = false;
+    return *this;
   }
 
   bool accepts(std::string_view message_type) const {
