@@ -17,6 +17,8 @@ packages=(
   libzstd-dev liblz4-dev nodejs
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
+  # independent readers in tests
+  python3-opencv python3-numpy
 )
 
 missing=()

@@ -1,6 +1,7 @@
 // Colour image with the pixel format it is stored in (packed or Bayer mosaic).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string_view>
 
@@ -22,6 +23,7 @@ struct ColorImage : MessageOf<ColorImage> {
 
   cv::Mat pixels;  // CV_8UC3 for bgr8/rgb8, CV_8UC1 for mono8 and Bayer
   PixelFormat format = PixelFormat::kBgr8;
+  std::int64_t device_timestamp_ns = 0;  // capture time on this camera's clock
 
   std::string summary() const override;
 };

@@ -2,6 +2,7 @@
 // depth projection.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 
 #include <opencv2/core/mat.hpp>
@@ -14,6 +15,7 @@ struct RawTofFrame : MessageOf<RawTofFrame> {
   static constexpr std::string_view kTypeName = "tilth.RawTofFrame";
 
   cv::Mat gray;  // CV_16UC1; 0 = no measurement
+  std::int64_t device_timestamp_ns = 0;  // capture time on this camera's clock
   // The camera's own gray-to-millimetre scale and offset (GenICam Scan3dCoordinateScale /
   // Scan3dCoordinateOffset) when it reports them; they win over the calibration file.
   std::optional<double> scale_mm;
