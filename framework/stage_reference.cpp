@@ -9,12 +9,12 @@ std::string ports_text(const std::vector<PortSpec>& ports) {
   std::string text;
   for (const auto& port : ports) {
     if (!text.empty()) text += ", ";
-    text += port.name + ":" + port.type;
+    text += port.name + ":" + port.type + (port.required ? "" : "?");
   }
   return text.empty() ? "-" : text;
 }
 
-std::string allowed_text(const ParamSpec& spec) {
+std::string allowed_text(const ParamSpec& spec, std::string_view separator = " | ") {
   std::ostringstream out;
   if (spec.min || spec.max) {
     out << "[";
@@ -24,7 +24,7 @@ std::string allowed_text(const ParamSpec& spec) {
     out << "]";
   }
   for (std::size_t i = 0; i < spec.choices.size(); ++i) {
-    out << (i ? " | " : "") << spec.choices[i];
+    out << (i ? separator : "") << spec.choices[i];
   }
   return out.str();
 }
@@ -55,7 +55,8 @@ std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
       if (ports->empty()) continue;
       out << (ports == &d.inputs ? "Inputs" : "Outputs") << ":\n\n";
       for (const auto& port : *ports) {
-        out << "- `" << port.name << "` (`" << port.type << "`): " << port.description << "\n";
+        out << "- `" << port.name << "` (`" << port.type << "`" << (port.required ? "" : ", optional")
+            << "): " << port.description << "\n";
       }
       out << "\n";
     }
@@ -76,7 +77,8 @@ std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
   for (const auto* ports : {&d.inputs, &d.outputs}) {
     out << (ports == &d.inputs ? "  inputs:" : "  outputs:") << (ports->empty() ? " none\n" : "\n");
     for (const auto& port : *ports) {
-      out << "    " << port.name << "  " << port.type << "  " << port.description << "\n";
+      out << "    " << port.name << "  " << port.type << (port.required ? "" : " (optional)") << "  "
+          << port.description << "\n";
     }
   }
   out << "  parameters:" << (d.params.empty() ? " none\n" : "\n");

@@ -17,7 +17,7 @@ cmake --build --preset default
 
 if [ "$mode" = demo ]; then
   shift
-  exec build/bin/tilth run graphs/demo.json --frames 150 "$@"
+  exec build/bin/tilth run graphs/demo.json --frames 100 "$@"
 fi
 
 ctest --preset default

@@ -12,7 +12,7 @@ packages=(
   # cameras (GigE Vision) and the camera simulator used by the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev iproute2
   # machine outputs and their real peers in tests
-  libmodbus-dev mbpoll python3-pymodbus
+  libmodbus-dev mbpoll python3-pymodbus python3-serial python3-serial-asyncio
   # recordings
   libzstd-dev liblz4-dev nodejs
   # tests and benchmarks

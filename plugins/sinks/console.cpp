@@ -1,5 +1,6 @@
-// Prints one line per frame to standard output: the frame id and a summary of each
-// message received. Accepts any message type.
+// Prints one line per frame to standard output: the frame id and a summary of the
+// message received, and of a second one when `also` is connected (a measurement beside
+// its ground truth). Accepts any message type.
 #include <iostream>
 #include <mutex>
 
@@ -10,6 +11,8 @@ namespace {
 
 class Console final : public Sink {
  public:
+  enum Port { kIn = 0, kAlso = 1 };
+
   explicit Console(const StageContext& context)
       : every_(static_cast<std::uint64_t>(context.params.integer("every"))),
         label_(context.params.string("label")) {}
@@ -17,7 +20,9 @@ class Console final : public Sink {
   void consume(const Frame& frame) override {
     if (frame.info().sequence % every_ != 0) return;
     std::cout << label_ << "frame " << frame.info().frame_id << ": "
-              << frame.input(0).message()->summary() << "\n";
+              << frame.input(kIn).message()->summary();
+    if (!frame.input(kAlso).empty()) std::cout << " | " << frame.input(kAlso).message()->summary();
+    std::cout << "\n";
   }
 
   void skipped(const FrameInfo& info) override {
@@ -36,7 +41,8 @@ StageDescriptor describe() {
   StageDescriptor d;
   d.type = "sinks.console";
   d.summary = "prints one line per frame with a summary of the message";
-  d.inputs = {PortSpec::any("in", "any message")};
+  d.inputs = {PortSpec::any("in", "any message"),
+              PortSpec::any("also", "printed after the first, when connected").optional()};
   d.params = {
       ParamSpec::integer("every", 1).range(1, std::nullopt).describe("print every n-th frame"),
       ParamSpec::string("label", "").describe("text put before each line"),

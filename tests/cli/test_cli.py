@@ -10,7 +10,7 @@ import unittest
 
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
-DEMO = os.path.join(SOURCE, "graphs", "demo.json")
+PLANE = os.path.join(SOURCE, "tests", "cli", "plane.json")
 
 
 def tilth(*args, timeout=60):
@@ -46,7 +46,7 @@ class HelpAndInspection(unittest.TestCase):
                       unknown.stderr)
 
     def test_dot(self):
-        result = tilth("dot", DEMO)
+        result = tilth("dot", PLANE)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn('n0 -> n1 [label="raw → in\\ntilth.RawTofFrame"]', result.stdout)
         svg = subprocess.run(["dot", "-Tsvg"], input=result.stdout, capture_output=True, text=True)
@@ -56,7 +56,7 @@ class HelpAndInspection(unittest.TestCase):
 
 class Validation(unittest.TestCase):
     def test_valid_graph(self):
-        result = tilth("validate", DEMO)
+        result = tilth("validate", PLANE)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn("valid, 2 nodes", result.stdout)
 
@@ -75,11 +75,11 @@ class Validation(unittest.TestCase):
         self.assertIn(path + ":/nodes/camera/params/nosie_mm: unknown parameter 'nosie_mm' of "
                       "synthetic.tof_plane; did you mean 'noise_mm'?", result.stderr)
         self.assertIn(path + ":/nodes/print/type: unknown stage type 'sinks.consol'; did you mean "
-                      "'sinks.console'?", result.stderr)
+                      "'sinks.console' or 'sinks.csv'?", result.stderr)
         self.assertIn("3 problem(s)", result.stderr)
 
     def test_bad_override_is_refused_before_running(self):
-        result = tilth("run", DEMO, "--set", "camera.fps=fast")
+        result = tilth("run", PLANE, "--set", "camera.fps=fast")
         self.assertEqual(result.returncode, 2)
         self.assertIn("command line:--set camera.fps: parameter 'fps': expected a number in "
                       "[0, 1000], got \"fast\"", result.stderr)
@@ -88,7 +88,7 @@ class Validation(unittest.TestCase):
 
 class Run(unittest.TestCase):
     def test_frame_limit_and_summary(self):
-        result = tilth("run", DEMO, "--frames", "10", "--set", "camera.fps=0",
+        result = tilth("run", PLANE, "--frames", "10", "--set", "camera.fps=0",
                        "--set", "print.every=1")
         self.assertEqual(result.returncode, 0, result.stderr)
         lines = result.stdout.splitlines()
@@ -98,7 +98,7 @@ class Run(unittest.TestCase):
 
     def stop_with(self, signum):
         process = subprocess.Popen(
-            [TILTH, "run", DEMO, "--set", "camera.fps=100", "--set", "print.every=1",
+            [TILTH, "run", PLANE, "--set", "camera.fps=100", "--set", "print.every=1",
              "--set", "runtime.when_full=block"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         time.sleep(1.5)

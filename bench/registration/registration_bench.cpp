@@ -1,0 +1,111 @@
+// registration.projective on one core, alone and after depth.projection: 640x480 depth,
+// 1280x1024 colour (bgr8 or a Bayer mosaic), the paper's rig, soil at about 518 mm.
+#include <algorithm>
+
+#include <benchmark/benchmark.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "projection.h"
+#include "projective.h"
+#include "tilth/frame.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/raw_tof_frame.h"
+
+namespace tilth::registration {
+namespace {
+
+const std::string kCalibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+
+std::unique_ptr<Stage> make(const StageDescriptor& descriptor, nlohmann::json params) {
+  params["calibration"] = kCalibration;
+  return descriptor.create(
+      StageContext{descriptor.type, Params(params), Logger(descriptor.type), {}});
+}
+
+std::shared_ptr<const Message> run(Stage& stage, std::span<const Packet> inputs) {
+  std::vector<Packet> outputs(1);
+  Frame frame(FrameInfo{}, inputs, outputs);
+  dynamic_cast<Transform&>(stage).process(frame);
+  return outputs[0].message();
+}
+
+// Raw ToF frame of soil at about 518 mm with 1 mm of range noise (synthetic.tof_plane's
+// default) and 2 % dropouts.
+Packet raw_frame() {
+  RawTofFrame raw;
+  raw.gray.create(480, 640, CV_16UC1);
+  cv::randn(raw.gray, 23666, 44);
+  cv::Mat dropouts(raw.gray.size(), CV_8UC1);
+  cv::randu(dropouts, 0, 100);
+  raw.gray.setTo(0, dropouts < 2);
+  return Packet(FrameInfo{}, std::make_shared<const RawTofFrame>(std::move(raw)));
+}
+
+Packet color_frame(PixelFormat format) {
+  ColorImage color;
+  color.format = format;
+  color.pixels.create(1024, 1280, CV_8UC(channels(format)));
+  cv::randu(color.pixels, 0, 256);
+  return Packet(FrameInfo{}, std::make_shared<const ColorImage>(std::move(color)));
+}
+
+const char* interpolation_name(std::int64_t bilinear) { return bilinear ? "bilinear" : "nearest"; }
+
+// Args: pixel format, bilinear (0/1).
+void BM_Registration(benchmark::State& state) {
+  cv::setNumThreads(0);  // one core: OpenCV's own threads (demosaicing) off too
+  const auto format = static_cast<PixelFormat>(state.range(0));
+  const auto projection = make(depth::describe_projection(), nlohmann::json::object());
+  const auto registration = make(
+      describe_projective(),
+      {{"occlusion_tolerance_mm", 10.0}, {"interpolation", interpolation_name(state.range(1))}});
+  const Packet raw = raw_frame();
+  const std::vector<Packet> inputs = {
+      Packet(FrameInfo{}, run(*projection, std::span<const Packet>(&raw, 1))), color_frame(format)};
+  for (auto _ : state) benchmark::DoNotOptimize(run(*registration, inputs).get());
+  state.SetLabel(std::string(to_string(format)) + ", " + interpolation_name(state.range(1)));
+}
+
+// Args: pixel format, bilinear (0/1).
+void BM_ProjectionAndRegistration(benchmark::State& state) {
+  cv::setNumThreads(0);
+  const auto format = static_cast<PixelFormat>(state.range(0));
+  const auto projection = make(depth::describe_projection(), nlohmann::json::object());
+  const auto registration = make(
+      describe_projective(),
+      {{"occlusion_tolerance_mm", 10.0}, {"interpolation", interpolation_name(state.range(1))}});
+  const Packet raw = raw_frame();
+  std::vector<Packet> inputs = {Packet(), color_frame(format)};
+  for (auto _ : state) {
+    inputs[0] = Packet(FrameInfo{}, run(*projection, std::span<const Packet>(&raw, 1)));
+    benchmark::DoNotOptimize(run(*registration, inputs).get());
+    inputs[0] = Packet();  // the depth image goes back to its pool
+  }
+  state.SetLabel(std::string(to_string(format)) + ", " + interpolation_name(state.range(1)));
+}
+
+void formats(benchmark::internal::Benchmark* b) {
+  for (const auto format : {PixelFormat::kBgr8, PixelFormat::kBayerRggb8}) {
+    for (const int bilinear : {0, 1}) b->Args({static_cast<int>(format), bilinear});
+  }
+}
+
+// The machine is shared: the fastest repetition is the stage's own cost, the median
+// what it gets under the current load.
+double fastest(const std::vector<double>& times) {
+  return *std::min_element(times.begin(), times.end());
+}
+
+BENCHMARK(BM_Registration)
+    ->Apply(formats)
+    ->Unit(benchmark::kMillisecond)
+    ->ComputeStatistics("min", fastest);
+BENCHMARK(BM_ProjectionAndRegistration)
+    ->Apply(formats)
+    ->Unit(benchmark::kMillisecond)
+    ->ComputeStatistics("min", fastest);
+
+}  // namespace
+}  // namespace tilth::registration

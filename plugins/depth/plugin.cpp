@@ -1,0 +1,4 @@
+// Depth stages: raw ToF frames to depth images.
+#include "tilth/plugin.h"
+
+TILTH_PLUGIN("depth")

@@ -1,0 +1,340 @@
+// estimation.ground_plane: a plane fitted to the soil points of a region of interest, read
+// at the tool's position, with the ground's tilt.
+//
+//   soil_depth ──► enough soil? ──► sampled rays (x', y') with depth Z ──► RANSAC (3-point
+//   planes, fixed seed) ──► least squares on the inliers, re-selected until stable ──►
+//   distance at tool_point, tilt, spread = RMS of the inlier residuals
+//
+// The plane is written a X + b Y + c Z = 1 in the ToF camera frame (origin at the optical
+// centre), so along the ray of undistorted normalised coordinates (x', y') it lies at
+// Z = 1 / (a x' + b y' + c): 1/Z is linear in (x', y'), which come from the calibration
+// and carry no noise. Residuals are along Z, in mm.
+//
+// Tilts are slope angles: tilt_x_deg = atan(dZ/dY) (the ground turned about the camera's
+// x axis; positive when it is farther towards +y, the bottom of the image), tilt_y_deg =
+// atan(dZ/dX) (about the y axis; positive when it is farther towards +x, the right).
+//
+//   "estimate": {"type": "estimation.ground_plane",
+//                "params": {"calibration": "rig.calib.json", "tool_point": [0, 120]}}
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <opencv2/calib3d.hpp>
+
+#include "estimators.h"
+#include "soil_region.h"
+#include "tilth/calibration.h"
+#include "tilth/error.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/ground_distance.h"
+#include "tilth/plugin.h"
+
+namespace tilth::estimation {
+namespace {
+
+// A bound only: re-fitting stops as soon as the inlier set no longer changes.
+constexpr int kMaxRefits = 10;
+// Any fixed value: the same frame always gives the same plane.
+constexpr std::uint32_t kRansacSeed = 20240611;
+
+struct GridPixel {
+  int row;
+  int col;
+  float x;  // undistorted normalised coordinates of the pixel's ray
+  float y;
+};
+
+struct SoilPoint {
+  double x;
+  double y;
+  double z;  // optical-centre depth, mm
+};
+
+class Plane {
+ public:
+  explicit Plane(const Eigen::Vector3d& abc) : abc_(abc) {}
+
+  // The plane through three soil points, unless they are (nearly) collinear.
+  static std::optional<Plane> through(const SoilPoint& p, const SoilPoint& q, const SoilPoint& r) {
+    Eigen::Matrix3d rays;
+    rays << p.x, p.y, 1, q.x, q.y, 1, r.x, r.y, 1;
+    // Normalised coordinates span about 1, so this is twice the triangle's area in them.
+    if (std::abs(rays.determinant()) < 1e-9) return std::nullopt;
+    return Plane(rays.partialPivLu().solve(Eigen::Vector3d(1 / p.z, 1 / q.z, 1 / r.z)));
+  }
+
+  bool inlier(const SoilPoint& point, double threshold_mm) const {
+    const double m = inverse_depth(point.x, point.y);
+    return m > 0 && std::abs(point.z * m - 1) <= threshold_mm * m;  // |Z - 1/m| <= threshold
+  }
+
+  double residual_mm(const SoilPoint& point) const {
+    return point.z - 1 / inverse_depth(point.x, point.y);
+  }
+
+  // Z of the plane at camera-frame (X, Y); not finite when the plane never gets there.
+  double depth_at(double x_mm, double y_mm) const {
+    return (1 - abc_[0] * x_mm - abc_[1] * y_mm) / abc_[2];
+  }
+  double slope_x() const { return -abc_[0] / abc_[2]; }  // dZ/dX
+  double slope_y() const { return -abc_[1] / abc_[2]; }  // dZ/dY
+
+ private:
+  double inverse_depth(double x, double y) const { return abc_[0] * x + abc_[1] * y + abc_[2]; }
+
+  Eigen::Vector3d abc_;
+};
+
+// Least squares of the residuals along Z: Z - 1/m ~= Z^2 m - Z near the plane (m ~= 1/Z),
+// which is linear in (a, b, c).
+std::optional<Plane> fit(const std::vector<SoilPoint>& points, const std::vector<bool>& inliers) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!inliers[i]) continue;
+    const SoilPoint& p = points[i];
+    const Eigen::Vector3d row = p.z * p.z * Eigen::Vector3d(p.x, p.y, 1);
+    normal += row * row.transpose();
+    right += p.z * row;
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> solver(normal);
+  if (solver.info() != Eigen::Success ||
+      solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
+    return std::nullopt;  // fewer than three inliers, or all on a line
+  }
+  return Plane(solver.solve(right));
+}
+
+// Marks the inliers of `plane`; returns how many there are and whether any flag changed.
+std::pair<std::size_t, bool> mark_inliers(const std::vector<SoilPoint>& points, const Plane& plane,
+                                          double threshold_mm, std::vector<bool>& inliers) {
+  std::size_t count = 0;
+  bool changed = false;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const bool inlier = plane.inlier(points[i], threshold_mm);
+    changed = changed || inlier != inliers[i];
+    inliers[i] = inlier;
+    count += inlier ? 1 : 0;
+  }
+  return {count, changed};
+}
+
+struct PlaneFit {
+  Plane plane;
+  std::size_t inliers;
+};
+
+// Least squares on the inliers of `plane`, re-selected and re-fitted until they no longer
+// change. Leaves the final inliers marked.
+std::optional<PlaneFit> refine(const std::vector<SoilPoint>& points, Plane plane,
+                               double threshold_mm, std::vector<bool>& inliers) {
+  inliers.assign(points.size(), false);
+  auto [count, changed] = mark_inliers(points, plane, threshold_mm, inliers);
+  for (int refit = 0; refit < kMaxRefits && changed; ++refit) {
+    const std::optional<Plane> better = fit(points, inliers);
+    if (!better) return std::nullopt;
+    plane = *better;
+    std::tie(count, changed) = mark_inliers(points, plane, threshold_mm, inliers);
+  }
+  return PlaneFit{plane, count};
+}
+
+std::optional<Plane> ransac(const std::vector<SoilPoint>& points, int hypotheses,
+                            double threshold_mm) {
+  std::mt19937 random(kRansacSeed);
+  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+  std::optional<Plane> best;
+  std::size_t best_inliers = 0;
+  for (int h = 0; h < hypotheses; ++h) {
+    const auto plane =
+        Plane::through(points[pick(random)], points[pick(random)], points[pick(random)]);
+    if (!plane) continue;
+    const auto inliers = static_cast<std::size_t>(
+        std::count_if(points.begin(), points.end(),
+                      [&](const SoilPoint& point) { return plane->inlier(point, threshold_mm); }));
+    if (inliers > best_inliers) {
+      best = plane;
+      best_inliers = inliers;
+    }
+  }
+  return best;
+}
+
+double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
+
+cv::Vec2d parse_tool_point(const nlohmann::json& value) {
+  if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number()) {
+    throw Error("parameter 'tool_point': expected [x_mm, y_mm] in the ToF camera frame, got " +
+                value.dump());
+  }
+  return {value[0].get<double>(), value[1].get<double>()};
+}
+
+std::string size_text(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// Every stride-th pixel of the region, with its ray, computed once.
+std::vector<GridPixel> sampling_grid(const DepthCameraCalibration& camera, const cv::Rect& roi,
+                                     int stride) {
+  std::vector<cv::Point2f> pixels;
+  for (int row = roi.y; row < roi.y + roi.height; row += stride) {
+    for (int col = roi.x; col < roi.x + roi.width; col += stride) {
+      pixels.emplace_back(static_cast<float>(col), static_cast<float>(row));
+    }
+  }
+  std::vector<cv::Point2f> rays;
+  cv::undistortPoints(pixels, rays, camera.camera_matrix(), camera.distortion);
+  std::vector<GridPixel> grid;
+  grid.reserve(pixels.size());
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    grid.push_back(
+        {static_cast<int>(pixels[i].y), static_cast<int>(pixels[i].x), rays[i].x, rays[i].y});
+  }
+  return grid;
+}
+
+class GroundPlaneEstimator final : public Transform {
+ public:
+  explicit GroundPlaneEstimator(const StageContext& context)
+      : camera_(load_calibration(context.params.path("calibration")).depth),
+        image_size_(camera_.width, camera_.height),
+        region_(context.params.json("roi")),
+        roi_(region_.on(image_size_)),
+        tool_point_mm_(parse_tool_point(context.params.json("tool_point"))),
+        requirement_(soil_requirement(context.params)),
+        threshold_mm_(context.params.number("outlier_threshold_mm")),
+        hypotheses_(static_cast<int>(context.params.integer("iterations"))),
+        min_inlier_fraction_(context.params.number("min_inlier_fraction")),
+        grid_(sampling_grid(camera_, roi_, static_cast<int>(context.params.integer("stride")))) {
+    if (region_.clipped_on(image_size_)) context.log.warning(region_.clipping_note(image_size_));
+  }
+
+  void process(Frame& frame) override {
+    const auto& soil = frame.input<DepthImage>(0);
+    if (soil.mm.type() != CV_32FC1 || soil.mm.size() != image_size_) {
+      throw Error("input 'soil_depth': expected a CV_32FC1 " + size_text(image_size_) +
+                  " image (the calibration's depth camera), got type " +
+                  std::to_string(soil.mm.type()) + ", " + size_text(soil.mm.size()));
+    }
+    GroundDistance out;
+    out.soil_pixels = count_finite(soil.mm, roi_);
+    out.soil_fraction = static_cast<double>(out.soil_pixels) / roi_.area();
+    out.invalid_reason = requirement_.shortfall(out.soil_pixels, roi_.area());
+    if (out.invalid_reason.empty()) measure(soil.mm, out);
+    frame.emit(0, std::move(out));
+  }
+
+ private:
+  void measure(const cv::Mat& soil_mm, GroundDistance& out) const {
+    thread_local std::vector<SoilPoint> points;
+    thread_local std::vector<bool> inliers;
+    points.clear();
+    for (const GridPixel& pixel : grid_) {
+      const float depth = soil_mm.at<float>(pixel.row, pixel.col);
+      if (std::isfinite(depth)) points.push_back({pixel.x, pixel.y, depth + camera_.z_offset_mm});
+    }
+    if (points.size() < 3) {
+      out.invalid_reason =
+          "too few soil points on the sampling grid: " + std::to_string(points.size()) +
+          " < 3 (lower 'stride')";
+      return;
+    }
+
+    const std::optional<Plane> guess = ransac(points, hypotheses_, threshold_mm_);
+    const std::optional<PlaneFit> fitted =
+        guess ? refine(points, *guess, threshold_mm_, inliers) : std::nullopt;
+    if (!fitted) {
+      out.invalid_reason = "no plane fits the soil points (fewer than 3 inliers, or all on a line)";
+      return;
+    }
+    const double inlier_fraction =
+        static_cast<double>(fitted->inliers) / static_cast<double>(points.size());
+    if (inlier_fraction < min_inlier_fraction_) {
+      out.invalid_reason = "no plane fits the soil: " + one_decimal(100.0 * inlier_fraction) +
+                           " % of the soil points lie within " + one_decimal(threshold_mm_) +
+                           " mm of the best plane < " + one_decimal(100.0 * min_inlier_fraction_) +
+                           " %";
+      return;
+    }
+    const Plane& plane = fitted->plane;
+    const double depth_at_tool = plane.depth_at(tool_point_mm_[0], tool_point_mm_[1]);
+    if (!std::isfinite(depth_at_tool) || depth_at_tool <= 0) {
+      out.invalid_reason = "the fitted plane does not lie in front of the camera at the tool point";
+      return;
+    }
+
+    double squares = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!inliers[i]) continue;
+      const double residual_mm = plane.residual_mm(points[i]);
+      squares += residual_mm * residual_mm;
+    }
+    out.spread_mm = std::sqrt(squares / static_cast<double>(fitted->inliers));
+    out.distance_mm = depth_at_tool - camera_.z_offset_mm;
+    out.tilt_x_deg = degrees(std::atan(plane.slope_y()));
+    out.tilt_y_deg = degrees(std::atan(plane.slope_x()));
+    out.valid = true;
+    out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
+  }
+
+  const DepthCameraCalibration camera_;
+  const cv::Size image_size_;
+  const RegionOfInterest region_;
+  const cv::Rect roi_;
+  const cv::Vec2d tool_point_mm_;
+  const SoilRequirement requirement_;
+  const double threshold_mm_;
+  const int hypotheses_;
+  const double min_inlier_fraction_;
+  const std::vector<GridPixel> grid_;
+};
+
+}  // namespace
+
+StageDescriptor describe_ground_plane() {
+  StageDescriptor d;
+  d.type = "estimation.ground_plane";
+  d.summary = "ground distance at the tool and ground tilt from a robust plane fit to the soil";
+  d.inputs = {PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere")};
+  d.outputs = {PortSpec::of<GroundDistance>(
+      "distance", "distance at the tool point, tilt, validity, spread (inlier RMS), confidence")};
+  d.params = {
+      ParamSpec::path("calibration", std::nullopt)
+          .describe("rig calibration file (tilth-calibration/1); its depth camera is used"),
+      roi_param(),
+      ParamSpec::json("tool_point", nlohmann::json::array({0.0, 0.0}))
+          .in_unit("mm")
+          .describe("[x, y] in the ToF camera frame where the distance is read; [0, 0] = axis"),
+      min_soil_fraction_param(),
+      min_soil_pixels_param(),
+      ParamSpec::number("outlier_threshold_mm", 10.0)
+          .range(0.1, 1000)
+          .in_unit("mm")
+          .describe("soil points farther than this from the plane (along Z) are outliers"),
+      ParamSpec::integer("iterations", 64)
+          .range(1, 10000)
+          .describe("RANSAC hypotheses (3-point planes) tried before the least-squares re-fits"),
+      ParamSpec::number("min_inlier_fraction", 0.5)
+          .range(0, 1)
+          .describe("below this fraction of soil points on the plane the measurement is invalid"),
+      ParamSpec::integer("stride", 4)
+          .range(1, 64)
+          .in_unit("px")
+          .describe("fit every stride-th pixel in each direction of the roi"),
+  };
+  d.concurrency = Concurrency::kParallel;
+  d.create = factory<GroundPlaneEstimator>();
+  return d;
+}
+
+TILTH_STAGE(describe_ground_plane());
+
+}  // namespace tilth::estimation

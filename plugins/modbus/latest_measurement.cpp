@@ -1,0 +1,61 @@
+#include "latest_measurement.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace tilth::modbus {
+
+bool is_too_little_soil(const GroundDistance& distance) {
+  if (distance.valid) return false;
+  std::string reason = distance.invalid_reason;
+  std::transform(reason.begin(), reason.end(), reason.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return reason.find("soil") != std::string::npos;
+}
+
+void LatestMeasurement::update(std::uint64_t frame_id, const GroundDistance& distance,
+                               Clock::time_point arrived, std::chrono::milliseconds capture_age) {
+  Measurement measurement{frame_id,
+                          distance.valid,
+                          is_too_little_soil(distance),
+                          distance.distance_mm,
+                          distance.soil_fraction,
+                          distance.confidence,
+                          arrived,
+                          std::max(capture_age, std::chrono::milliseconds(0))};
+  std::lock_guard lock(mutex_);
+  measurement_ = measurement;
+  last_frame_ = arrived;
+  last_frame_missing_ = false;
+}
+
+void LatestMeasurement::update_missing(Clock::time_point arrived) {
+  std::lock_guard lock(mutex_);
+  last_frame_ = arrived;
+  last_frame_missing_ = true;
+}
+
+RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
+  std::lock_guard lock(mutex_);
+  RegisterValues values;
+  values.camera_ok = last_frame_ && now - *last_frame_ <= stale_timeout_;
+  values.pipeline_error = last_frame_missing_;
+  if (!measurement_) {
+    values.stale = true;
+    values.age = std::chrono::milliseconds::max();  // never: saturates
+    return values;
+  }
+  const auto since_arrival =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now - measurement_->arrived);
+  values.stale = since_arrival > stale_timeout_;
+  values.valid = measurement_->valid && !values.stale;
+  values.too_little_soil = measurement_->too_little_soil;
+  values.distance_mm = measurement_->distance_mm;
+  values.soil_fraction = measurement_->soil_fraction;
+  values.confidence = measurement_->confidence;
+  values.frame_id = measurement_->frame_id;
+  values.age = measurement_->capture_age + std::max(since_arrival, std::chrono::milliseconds(0));
+  return values;
+}
+
+}  // namespace tilth::modbus

@@ -1,0 +1,56 @@
+// The newest measurement a Modbus output has received, shared between the graph, which
+// updates it from the sink's consume(), and the thread that talks Modbus, which turns it
+// into register values at the moment it answers or writes (so age and staleness are
+// exact then, whether or not measurements still arrive).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+
+#include "register_map.h"
+#include "tilth/messages/ground_distance.h"
+
+namespace tilth::modbus {
+
+class LatestMeasurement {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  explicit LatestMeasurement(std::chrono::milliseconds stale_timeout)
+      : stale_timeout_(stale_timeout) {}
+
+  // `capture_age`: how old the frame already was when it arrived here.
+  void update(std::uint64_t frame_id, const GroundDistance& distance, Clock::time_point arrived,
+              std::chrono::milliseconds capture_age);
+  // A frame arrived without a measurement: a stage upstream failed on it.
+  void update_missing(Clock::time_point arrived);
+
+  // Everything but the heartbeat, which belongs to the link that publishes the values.
+  RegisterValues values_at(Clock::time_point now) const;
+
+ private:
+  struct Measurement {
+    std::uint64_t frame_id = 0;
+    bool valid = false;
+    bool too_little_soil = false;
+    double distance_mm = 0.0;
+    double soil_fraction = 0.0;
+    double confidence = 0.0;
+    Clock::time_point arrived;
+    std::chrono::milliseconds capture_age{0};
+  };
+
+  const std::chrono::milliseconds stale_timeout_;
+  mutable std::mutex mutex_;
+  std::optional<Measurement> measurement_;
+  std::optional<Clock::time_point> last_frame_;  // with or without a measurement
+  bool last_frame_missing_ = false;
+};
+
+// The estimator says why a measurement is invalid in words; "too little soil" is the
+// reason the PLC is told apart, so any reason that mentions soil counts.
+bool is_too_little_soil(const GroundDistance& distance);
+
+}  // namespace tilth::modbus

@@ -1,0 +1,129 @@
+// modbus.output: hands the ground distance to the machine's PLC over Modbus TCP, either
+// as a server the PLC polls or as a client that writes into the PLC's registers. The
+// sink only records the newest measurement; the server or client thread publishes it,
+// so a slow or absent PLC never holds up the graph. docs/modbus.md has the register map.
+#include <arpa/inet.h>
+
+#include <chrono>
+#include <memory>
+
+#include "latest_measurement.h"
+#include "modbus_client.h"
+#include "modbus_server.h"
+#include "register_map.h"
+#include "tilth/plugin.h"
+
+namespace tilth::modbus {
+namespace {
+
+constexpr const char* kAnyAddress = "0.0.0.0";
+
+std::string ipv4_address(const Params& params, bool client) {
+  const std::string address = params.string("address");
+  in_addr parsed{};
+  if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) {
+    throw Error("parameter 'address': expected an IPv4 address such as 192.168.1.10, got '" +
+                address + "'");
+  }
+  if (client && address == kAnyAddress) {
+    throw Error("parameter 'address': mode 'client' needs the PLC's IP address, not " +
+                std::string(kAnyAddress));
+  }
+  return address;
+}
+
+class ModbusOutput final : public Sink {
+ public:
+  enum Port { kDistance = 0 };
+
+  explicit ModbusOutput(const StageContext& context)
+      : latest_(std::chrono::milliseconds(context.params.integer("stale_timeout_ms"))) {
+    const Params& params = context.params;
+    const bool client = params.string("mode") == "client";
+    const std::string address = ipv4_address(params, client);
+    const auto port = static_cast<int>(params.integer("port"));
+    const auto unit_id = static_cast<int>(params.integer("unit_id"));
+    const auto base_register = static_cast<int>(params.integer("base_register"));
+    const WordOrder word_order = parse_word_order(params.string("word_order"));
+    if (client) {
+      client_ = std::make_unique<ModbusClient>(
+          ClientOptions{address, port, unit_id, base_register, word_order,
+                        std::chrono::milliseconds(params.integer("write_interval_ms"))},
+          latest_, context.log);
+    } else {
+      server_ = std::make_unique<ModbusServer>(
+          ServerOptions{address, port, unit_id, base_register, word_order,
+                        static_cast<int>(params.integer("max_clients"))},
+          latest_, context.log);
+    }
+  }
+
+  void consume(const Frame& frame) override {
+    const auto& info = frame.info();
+    // How old the frame already is, on the host clock the source stamped it with.
+    std::chrono::milliseconds capture_age{0};
+    if (info.host_timestamp_ns != 0) {
+      capture_age = std::chrono::duration_cast<std::chrono::milliseconds>(
+          std::chrono::system_clock::now().time_since_epoch() -
+          std::chrono::nanoseconds(info.host_timestamp_ns));
+    }
+    latest_.update(info.frame_id, frame.input<GroundDistance>(kDistance),
+                   LatestMeasurement::Clock::now(), capture_age);
+  }
+
+  void skipped(const FrameInfo& /*info*/) override {
+    latest_.update_missing(LatestMeasurement::Clock::now());
+  }
+
+  void finish() override {
+    server_.reset();
+    client_.reset();
+  }
+
+ private:
+  LatestMeasurement latest_;  // first: outlives the threads that read it
+  std::unique_ptr<ModbusServer> server_;
+  std::unique_ptr<ModbusClient> client_;
+};
+
+StageDescriptor describe() {
+  constexpr auto kLastBase = 65536 - static_cast<std::int64_t>(kRegisterCount);
+  StageDescriptor d;
+  d.type = "modbus.output";
+  d.summary = "hands the ground distance to a PLC over Modbus TCP (docs/modbus.md)";
+  d.inputs = {PortSpec::of<GroundDistance>("distance", "the measurement to publish")};
+  d.params = {
+      ParamSpec::choice("mode", {"server", "client"}, "server")
+          .describe("server: the PLC polls Tilth; client: Tilth writes into the PLC"),
+      ParamSpec::string("address", kAnyAddress)
+          .describe("server: IPv4 address to listen on (0.0.0.0 = all); client: the PLC's"),
+      ParamSpec::integer("port", 502).range(1, 65535).describe("TCP port"),
+      ParamSpec::integer("unit_id", 1)
+          .range(0, 247)
+          .describe("Modbus unit id (server: also answers 0 and 255)"),
+      ParamSpec::integer("base_register", 0)
+          .range(0, kLastBase)
+          .describe("address of the block's first register (0-based, PDU addressing)"),
+      ParamSpec::choice("word_order", {"big", "little"}, "big")
+          .describe("32-bit values: big = high word first; bytes in a word are big-endian"),
+      ParamSpec::integer("stale_timeout_ms", 200)
+          .range(1, 60000)
+          .in_unit("ms")
+          .describe("without a new measurement for this long, valid clears and stale sets"),
+      ParamSpec::integer("write_interval_ms", 40)
+          .range(1, 60000)
+          .in_unit("ms")
+          .describe("client: time between writes"),
+      ParamSpec::integer("max_clients", 8)
+          .range(1, 256)
+          .describe("server: connections served at once; the quietest makes room"),
+  };
+  d.create = factory<ModbusOutput>();
+  return d;
+}
+
+}  // namespace
+
+TILTH_STAGE(describe());
+
+}  // namespace tilth::modbus

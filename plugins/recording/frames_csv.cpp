@@ -1,0 +1,196 @@
+#include "frames_csv.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <string_view>
+
+#include "tilth/error.h"
+
+namespace tilth::recording {
+namespace {
+
+namespace fs = std::filesystem;
+
+enum Column { kIndex, kDepthTimestamp, kColorTimestamp, kDepth, kColor, kMask, kGroundTruth };
+constexpr std::array<std::string_view, 7> kColumnNames{
+    "index", "depth_timestamp_ns", "color_timestamp_ns", "depth", "color",
+    "mask",  "ground_truth_mm"};
+constexpr std::size_t kRequiredColumns = 5;  // index .. color; mask and ground truth optional
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> fields;
+  for (;;) {
+    const auto comma = line.find(',');
+    fields.push_back(line.substr(0, comma));
+    if (comma == std::string_view::npos) return fields;
+    line.remove_prefix(comma + 1);
+  }
+}
+
+const std::string& expected_columns() {
+  static const std::string text = [] {
+    std::string columns;
+    for (std::size_t c = 0; c < kColumnNames.size(); ++c) {
+      columns += (c == 0                  ? ""
+                  : c == kRequiredColumns ? " and optionally "
+                                          : ", ") +
+                 std::string(kColumnNames[c]);
+    }
+    return "expected columns " + columns;
+  }();
+  return text;
+}
+
+// Reads one line's fields, naming the file and line in every error.
+class LineReader {
+ public:
+  LineReader(const fs::path& file, std::size_t line) : file_(file), line_(line) {}
+
+  [[noreturn]] void fail(const std::string& message) const {
+    throw Error(file_.string() + ":" + std::to_string(line_) + ": " + message);
+  }
+  [[noreturn]] void fail(Column column, const std::string& expected, std::string_view got) const {
+    fail("column '" + std::string(kColumnNames[column]) + "': expected " + expected + ", got '" +
+         std::string(got) + "'");
+  }
+
+  template <class Integer>
+  Integer integer(Column column, std::string_view text, const std::string& expected) const {
+    Integer value{};
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+      fail(column, expected, text);
+    }
+    return value;
+  }
+
+  std::optional<double> optional_number(Column column, std::string_view text) const {
+    if (text.empty()) return std::nullopt;
+    double value = 0.0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
+      fail(column, "a number of millimetres or nothing", text);
+    }
+    return value;
+  }
+
+  std::string path(Column column, std::string_view text) const {
+    if (text.empty()) fail(column, "a file path relative to the recording folder", text);
+    return std::string(text);
+  }
+
+ private:
+  const fs::path& file_;
+  const std::size_t line_;
+};
+
+// Where each known column is in the file's header.
+using ColumnPositions = std::array<std::optional<std::size_t>, kColumnNames.size()>;
+
+ColumnPositions read_header(const fs::path& file, std::string_view header) {
+  const LineReader reader(file, 1);
+  ColumnPositions positions;
+  const auto names = split(header);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::size_t c = 0;
+    while (c < kColumnNames.size() && kColumnNames[c] != names[i]) ++c;
+    if (c == kColumnNames.size()) {
+      reader.fail("unknown column '" + std::string(names[i]) + "' (" + expected_columns() + ")");
+    }
+    if (positions[c]) reader.fail("column '" + std::string(names[i]) + "' appears twice");
+    positions[c] = i;
+  }
+  for (std::size_t c = 0; c < kRequiredColumns; ++c) {
+    if (!positions[c]) {
+      reader.fail("missing required column '" + std::string(kColumnNames[c]) + "' (" +
+                  expected_columns() + ")");
+    }
+  }
+  return positions;
+}
+
+// Indices and each camera's timestamps strictly increase: the frames are in capture order
+// and each is there once.
+template <class Value>
+void check_increasing(const LineReader& reader, Column column, Value previous, Value current,
+                      std::size_t previous_line) {
+  if (current <= previous) {
+    reader.fail(
+        column,
+        "a value > " + std::to_string(previous) + " (line " + std::to_string(previous_line) + ")",
+        std::to_string(current));
+  }
+}
+
+}  // namespace
+
+std::vector<FrameEntry> read_frames_csv(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot read (is this a recording folder?)");
+  std::string text;
+  if (!std::getline(in, text))
+    throw Error(file.string() + ":1: expected the header line, got an empty file");
+  // Tolerate files written on Windows.
+  if (!text.empty() && text.back() == '\r') text.pop_back();
+  const ColumnPositions positions = read_header(file, text);
+  const std::size_t field_count = split(text).size();
+
+  std::vector<FrameEntry> entries;
+  for (std::size_t line = 2; std::getline(in, text); ++line) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (text.empty()) continue;
+    const LineReader reader(file, line);
+    const auto fields = split(text);
+    if (fields.size() != field_count) {
+      reader.fail("expected " + std::to_string(field_count) + " fields as in the header, got " +
+                  std::to_string(fields.size()));
+    }
+    const auto field = [&](Column column) {
+      return positions[column] ? fields[*positions[column]] : std::string_view();
+    };
+    FrameEntry entry;
+    entry.line = line;
+    entry.index = reader.integer<std::uint64_t>(kIndex, field(kIndex), "a non-negative integer");
+    entry.depth_timestamp_ns = reader.integer<std::int64_t>(kDepthTimestamp, field(kDepthTimestamp),
+                                                            "an integer number of nanoseconds");
+    entry.color_timestamp_ns = reader.integer<std::int64_t>(kColorTimestamp, field(kColorTimestamp),
+                                                            "an integer number of nanoseconds");
+    entry.depth = reader.path(kDepth, field(kDepth));
+    entry.color = reader.path(kColor, field(kColor));
+    entry.mask = std::string(field(kMask));
+    entry.ground_truth_mm = reader.optional_number(kGroundTruth, field(kGroundTruth));
+    if (!entries.empty()) {
+      const FrameEntry& previous = entries.back();
+      check_increasing(reader, kIndex, previous.index, entry.index, previous.line);
+      check_increasing(reader, kDepthTimestamp, previous.depth_timestamp_ns,
+                       entry.depth_timestamp_ns, previous.line);
+      check_increasing(reader, kColorTimestamp, previous.color_timestamp_ns,
+                       entry.color_timestamp_ns, previous.line);
+    }
+    entries.push_back(std::move(entry));
+  }
+  return entries;
+}
+
+std::string frames_csv_line(const FrameEntry& entry) {
+  std::string ground_truth;
+  if (entry.ground_truth_mm) {
+    // The shortest text that reads back as the same double, with at least two decimals.
+    // 400 characters hold any finite double in fixed notation.
+    std::array<char, 400> buffer{};
+    const auto end = std::to_chars(buffer.data(), buffer.data() + buffer.size(),
+                                   *entry.ground_truth_mm, std::chars_format::fixed)
+                         .ptr;
+    ground_truth.assign(buffer.data(), end);
+    if (ground_truth.find('.') == std::string::npos) ground_truth += ".";
+    const std::size_t decimals = ground_truth.size() - ground_truth.find('.') - 1;
+    if (decimals < 2) ground_truth.append(2 - decimals, '0');
+  }
+  return std::to_string(entry.index) + "," + std::to_string(entry.depth_timestamp_ns) + "," +
+         std::to_string(entry.color_timestamp_ns) + "," + entry.depth + "," + entry.color + "," +
+         entry.mask + "," + ground_truth;
+}
+
+}  // namespace tilth::recording

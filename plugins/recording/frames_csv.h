@@ -1,0 +1,37 @@
+// frames.csv of an image-folder recording: the whole index read and checked at once,
+// and the lines the writer appends.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tilth::recording {
+
+// The header the writer writes: every column, in the spec's order.
+inline constexpr std::string_view kFramesCsvHeader =
+    "index,depth_timestamp_ns,color_timestamp_ns,depth,color,mask,ground_truth_mm";
+
+struct FrameEntry {
+  std::size_t line = 0;  // in frames.csv, counting the header as line 1
+  std::uint64_t index = 0;
+  std::int64_t depth_timestamp_ns = 0;
+  std::int64_t color_timestamp_ns = 0;
+  std::string depth;  // paths relative to the recording folder
+  std::string color;
+  std::string mask;  // empty: no mask
+  std::optional<double> ground_truth_mm;
+};
+
+// Reads every line; throws tilth::Error naming the file, the line and what was expected
+// for a missing or unknown column, a malformed field, or an index or timestamp that
+// does not increase.
+std::vector<FrameEntry> read_frames_csv(const std::filesystem::path& file);
+
+// One line of frames.csv, without the newline, in kFramesCsvHeader's column order.
+std::string frames_csv_line(const FrameEntry& entry);
+
+}  // namespace tilth::recording

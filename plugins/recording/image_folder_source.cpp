@@ -1,0 +1,209 @@
+// Replays an image-folder recording (spec: tilth-image-folder/1): raw ToF frames, colour
+// images and ground truth, in frames.csv order, as fast as possible or paced by the
+// depth timestamps. recording.json and all of frames.csv are checked before the first
+// frame, so a malformed recording fails before the graph runs; the PNGs are read frame
+// by frame.
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "frames_csv.h"
+#include "pixel_checks.h"
+#include "recording_json.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_truth.h"
+#include "tilth/messages/raw_tof_frame.h"
+#include "tilth/plugin.h"
+
+namespace tilth::recording {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t kRawPort = 0;
+constexpr std::size_t kColorPort = 1;
+constexpr std::size_t kTruthPort = 2;
+
+struct FrameImages {
+  cv::Mat depth;
+  cv::Mat color;
+  cv::Mat mask;  // empty: the frame has no mask
+};
+
+class ImageFolderSource final : public Source {
+ public:
+  explicit ImageFolderSource(const StageContext& context)
+      : folder_(context.params.path("path")),
+        recording_(read_recording_json(folder_)),
+        frames_(read_frames_csv(folder_ / "frames.csv")),
+        rate_(context.params.number("rate")),
+        stop_on_missing_(context.params.string("on_missing") == "stop"),
+        loop_(context.params.boolean("loop")),
+        log_(context.log) {}
+
+  bool produce(Frame& frame) override {
+    for (;;) {
+      if (next_ == frames_.size()) {
+        if (!loop_ || frames_.empty()) return false;
+        if (!produced_this_pass_) {
+          log_.warning(folder_.string() + ": no frame of the recording could be read; not looping");
+          return false;
+        }
+        next_ = 0;
+      }
+      if (next_ == 0) {
+        pass_start_ = Clock::now();
+        produced_this_pass_ = false;
+      }
+      const FrameEntry& entry = frames_[next_++];
+      if (!wait_until_due(entry)) return false;
+      if (auto images = read_images(entry)) {
+        emit(frame, entry, std::move(*images));
+        produced_this_pass_ = true;
+        return true;
+      }
+    }
+  }
+
+  void interrupt() override {
+    {
+      std::lock_guard lock(mutex_);
+      interrupted_ = true;
+    }
+    wake_.notify_all();
+  }
+
+ private:
+  // Paces by the depth timestamps, relative to the first frame of the pass: a late frame
+  // does not shift the schedule, the frames after it catch up. False when interrupted.
+  bool wait_until_due(const FrameEntry& entry) {
+    std::unique_lock lock(mutex_);
+    if (rate_ > 0) {
+      const double recorded_ns =
+          static_cast<double>(entry.depth_timestamp_ns - frames_.front().depth_timestamp_ns);
+      const auto due =
+          pass_start_ + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double, std::nano>(recorded_ns / rate_));
+      wake_.wait_until(lock, due, [this] { return interrupted_; });
+    }
+    return !interrupted_;
+  }
+
+  // The frame's images, checked; nullopt when one is missing or unreadable and
+  // on_missing is skip.
+  std::optional<FrameImages> read_images(const FrameEntry& entry) const {
+    const cv::Size depth_size(recording_.calibration.depth.width,
+                              recording_.calibration.depth.height);
+    const cv::Size color_size(recording_.calibration.color.width,
+                              recording_.calibration.color.height);
+    FrameImages images;
+    images.depth = read_image(entry, entry.depth, CV_16UC1, depth_size, "depth_camera");
+    if (images.depth.empty()) return std::nullopt;
+    images.color = read_image(entry, entry.color, CV_8UC(channels(recording_.color_format)),
+                              color_size, "color_camera");
+    if (images.color.empty()) return std::nullopt;
+    if (!entry.mask.empty()) {
+      images.mask = read_image(entry, entry.mask, CV_8UC1, depth_size, "depth_camera");
+      if (images.mask.empty()) return std::nullopt;
+    }
+    return images;
+  }
+
+  // An empty image when the file is missing or unreadable and on_missing is skip.
+  cv::Mat read_image(const FrameEntry& entry, const std::string& relative, int type, cv::Size size,
+                     std::string_view camera) const {
+    const fs::path file = folder_ / relative;
+    const std::string where =
+        file.string() + " (frames.csv line " + std::to_string(entry.line) + ")";
+    cv::Mat image;
+    std::string problem;
+    if (!fs::exists(file)) {
+      problem = "no such file";
+    } else {
+      image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+      if (image.empty()) problem = "not a readable image";
+    }
+    if (!problem.empty()) {
+      if (stop_on_missing_) throw Error(where + ": " + problem + " (on_missing: stop)");
+      log_.warning(where + ": " + problem + "; frame " + std::to_string(entry.index) +
+                   " skipped (on_missing: skip)");
+      return {};
+    }
+    const std::string mismatch =
+        pixel_mismatch(image, type, size, std::string(camera) + " in the calibration");
+    if (!mismatch.empty()) throw Error(where + ": " + mismatch);
+    return image;
+  }
+
+  void emit(Frame& frame, const FrameEntry& entry, FrameImages images) const {
+    const auto host_now = std::chrono::system_clock::now().time_since_epoch();
+    frame.set_capture(entry.index, entry.depth_timestamp_ns,
+                      std::chrono::duration_cast<std::chrono::nanoseconds>(host_now).count());
+    RawTofFrame raw;
+    raw.gray = std::move(images.depth);
+    raw.device_timestamp_ns = entry.depth_timestamp_ns;
+    frame.emit(kRawPort, std::move(raw));
+    ColorImage color;
+    color.pixels = std::move(images.color);
+    color.format = recording_.color_format;
+    color.device_timestamp_ns = entry.color_timestamp_ns;
+    frame.emit(kColorPort, std::move(color));
+    GroundTruth truth;
+    truth.distance_mm = entry.ground_truth_mm;
+    truth.residue_mask = std::move(images.mask);
+    frame.emit(kTruthPort, std::move(truth));
+  }
+
+  const fs::path folder_;
+  const RecordingJson recording_;
+  const std::vector<FrameEntry> frames_;
+  const double rate_;
+  const bool stop_on_missing_;
+  const bool loop_;
+  const Logger log_;
+
+  std::size_t next_ = 0;  // the next entry of frames_
+  bool produced_this_pass_ = false;
+  Clock::time_point pass_start_;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool interrupted_ = false;
+};
+
+StageDescriptor describe() {
+  StageDescriptor d;
+  d.type = "recording.image_folder";
+  d.summary = "replays an image-folder recording (PNG files and frames.csv)";
+  d.outputs = {
+      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray; device time = depth_timestamp_ns"),
+      PortSpec::of<ColorImage>("color",
+                               "bgr8 or a Bayer mosaic as recorded; device time = "
+                               "color_timestamp_ns"),
+      PortSpec::of<GroundTruth>("truth",
+                                "ground_truth_mm and the mask when the recording has them"),
+  };
+  d.params = {
+      ParamSpec::path("path", std::nullopt).describe("the recording folder"),
+      ParamSpec::number("rate", 0.0)
+          .range(0, std::nullopt)
+          .describe("playback speed: 0 = as fast as possible, 1 = as recorded (paced by the depth "
+                    "timestamps), 2 = twice as fast"),
+      ParamSpec::choice("on_missing", {"skip", "stop"}, "skip")
+          .describe("a missing or unreadable PNG: skip the frame with a warning, or stop"),
+      ParamSpec::boolean("loop", false).describe("start again after the last frame"),
+  };
+  d.concurrency = Concurrency::kSerial;
+  d.create = factory<ImageFolderSource>();
+  return d;
+}
+
+}  // namespace
+
+TILTH_STAGE(describe());
+
+}  // namespace tilth::recording

@@ -1,0 +1,230 @@
+// Writes frames as an image-folder recording (spec: tilth-image-folder/1) that
+// recording.image_folder replays. Every frame is checked against what the reader
+// accepts before any of its files is written, and its frames.csv line is appended and
+// flushed only after its PNGs are complete: a killed process leaves a valid recording
+// that lacks at most the frame being written.
+#include <array>
+#include <fstream>
+#include <iomanip>
+#include <optional>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "frames_csv.h"
+#include "pixel_checks.h"
+#include "recording_json.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_truth.h"
+#include "tilth/messages/raw_tof_frame.h"
+#include "tilth/plugin.h"
+
+namespace tilth::recording {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kRawPort = 0;
+constexpr std::size_t kColorPort = 1;
+constexpr std::size_t kTruthPort = 2;
+constexpr std::string_view kCalibrationFile = "rig.calib.json";
+// What replacing a recording removes; anything else in the folder stays.
+constexpr std::array<std::string_view, 6> kRecordingEntries{
+    "recording.json", "frames.csv", kCalibrationFile, "depth", "color", "mask"};
+
+// The frame's file name: its index, six digits or more.
+std::string file_name(std::uint64_t index) {
+  std::ostringstream name;
+  name << std::setw(6) << std::setfill('0') << index << ".png";
+  return name.str();
+}
+
+// Throws unless the folder can be written: it does not exist, is empty, or holds a
+// recording that `overwrite` allows to replace. Changes nothing, so a graph that fails to
+// start leaves the folder as it was.
+void check_folder(const fs::path& folder, bool overwrite) {
+  if (!fs::exists(folder)) return;
+  if (!fs::is_directory(folder)) throw Error(folder.string() + ": exists and is not a folder");
+  if (fs::is_empty(folder)) return;
+  if (!overwrite) {
+    throw Error(folder.string() +
+                ": folder exists and is not empty; set overwrite: true to replace the "
+                "recording in it");
+  }
+  if (!fs::exists(folder / "recording.json")) {
+    throw Error(folder.string() +
+                ": folder is not empty and holds no recording.json; not overwriting a folder "
+                "that is not a recording");
+  }
+}
+
+std::string read_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw Error(file.string() + ": cannot read");
+  return text.str();
+}
+
+struct StoredColor {
+  PixelFormat format;
+  cv::Mat pixels;
+};
+
+void write_png(const fs::path& file, const cv::Mat& image) {
+  if (!cv::imwrite(file.string(), image)) throw Error(file.string() + ": cannot write PNG");
+}
+
+class ImageFolderWriter final : public Sink {
+ public:
+  explicit ImageFolderWriter(const StageContext& context)
+      : folder_(context.params.path("path")),
+        calibration_(load_calibration(context.params.path("calibration"))),
+        // Kept, not copied later: the file may be in the folder that overwrite replaces.
+        calibration_text_(read_file(context.params.path("calibration"))),
+        description_(context.params.string("description")),
+        depth_size_(calibration_.depth.width, calibration_.depth.height),
+        color_size_(calibration_.color.width, calibration_.color.height) {
+    check_folder(folder_, context.params.boolean("overwrite"));
+  }
+
+  void consume(const Frame& frame) override {
+    const auto& raw = frame.input<RawTofFrame>(kRawPort);
+    const auto& color = frame.input<ColorImage>(kColorPort);
+    const Packet& truth_packet = frame.input(kTruthPort);
+    const GroundTruth* truth = truth_packet.empty() ? nullptr : &truth_packet.get<GroundTruth>();
+
+    FrameEntry entry;
+    entry.index = frame.info().frame_id;
+    entry.depth_timestamp_ns = raw.device_timestamp_ns;
+    entry.color_timestamp_ns = color.device_timestamp_ns;
+    entry.depth = "depth/" + file_name(entry.index);
+    entry.color = "color/" + file_name(entry.index);
+    if (truth != nullptr && !truth->residue_mask.empty()) {
+      entry.mask = "mask/" + file_name(entry.index);
+    }
+    if (truth != nullptr) entry.ground_truth_mm = truth->distance_mm;
+    check_order(entry);
+    check("raw",
+          pixel_mismatch(raw.gray, CV_16UC1, depth_size_, "depth_camera in the calibration"));
+    const StoredColor stored = stored_color(color);
+    if (!entry.mask.empty()) {
+      check("truth mask", pixel_mismatch(truth->residue_mask, CV_8UC1, depth_size_,
+                                         "depth_camera in the calibration"));
+    }
+
+    if (!color_format_) start(stored.format);
+    write_png(folder_ / entry.depth, raw.gray);
+    write_png(folder_ / entry.color, stored.pixels);
+    if (!entry.mask.empty()) {
+      fs::create_directories(folder_ / "mask");
+      write_png(folder_ / entry.mask, truth->residue_mask);
+    }
+    csv_ << frames_csv_line(entry) << "\n" << std::flush;
+    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+    previous_ = entry;
+  }
+
+  void finish() override {
+    // A recording without frames is still a valid, empty one.
+    if (!color_format_) start(PixelFormat::kBgr8);
+    csv_.close();
+    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+  }
+
+ private:
+  // Replaces the old recording, if any, with an empty one in `color_format`. Runs with
+  // the first frame to write, so a graph that does not run changes nothing.
+  void start(PixelFormat color_format) {
+    for (std::string_view entry : kRecordingEntries) fs::remove_all(folder_ / entry);
+    fs::create_directories(folder_ / "depth");
+    fs::create_directories(folder_ / "color");
+    write_recording_json(folder_, std::string(kCalibrationFile), color_format, description_);
+    std::ofstream calibration(folder_ / kCalibrationFile, std::ios::binary);
+    calibration << calibration_text_;
+    if (!calibration) throw Error((folder_ / kCalibrationFile).string() + ": cannot write");
+    csv_.open(folder_ / "frames.csv");
+    csv_ << kFramesCsvHeader << "\n" << std::flush;
+    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+    color_format_ = color_format;
+  }
+
+  static void check(std::string_view port, const std::string& mismatch) {
+    if (!mismatch.empty()) throw Error(std::string(port) + ": " + mismatch);
+  }
+
+  // The reader refuses indices and timestamps that do not increase.
+  void check_order(const FrameEntry& entry) const {
+    if (!previous_) return;
+    const auto expect_after = [](std::string_view what, auto previous, auto current) {
+      if (current <= previous) {
+        throw Error(std::string(what) + ": expected a value > " + std::to_string(previous) +
+                    " (the previous frame's), got " + std::to_string(current));
+      }
+    };
+    expect_after("frame id", previous_->index, entry.index);
+    expect_after("raw device timestamp", previous_->depth_timestamp_ns, entry.depth_timestamp_ns);
+    expect_after("color device timestamp", previous_->color_timestamp_ns, entry.color_timestamp_ns);
+  }
+
+  // The colour image as the recording stores it: rgb8 becomes bgr8, and the format must
+  // be the one of the first frame.
+  StoredColor stored_color(const ColorImage& color) const {
+    const PixelFormat format =
+        color.format == PixelFormat::kRgb8 ? PixelFormat::kBgr8 : color.format;
+    if (!is_recording_color_format(format)) {
+      throw Error("color: " + std::string(to_string(color.format)) +
+                  " cannot be recorded; expected bgr8, rgb8 (stored as bgr8) or a Bayer mosaic");
+    }
+    if (color_format_ && format != *color_format_) {
+      throw Error("color: expected " + std::string(to_string(*color_format_)) +
+                  " as in the first frame (a recording has one color_format), got " +
+                  std::string(to_string(color.format)));
+    }
+    check("color", pixel_mismatch(color.pixels, CV_8UC(channels(format)), color_size_,
+                                  "color_camera in the calibration"));
+    if (color.format != PixelFormat::kRgb8) return {format, color.pixels};
+    cv::Mat bgr;
+    cv::cvtColor(color.pixels, bgr, cv::COLOR_RGB2BGR);
+    return {format, bgr};
+  }
+
+  const fs::path folder_;
+  const RigCalibration calibration_;
+  const std::string calibration_text_;
+  const std::string description_;
+  const cv::Size depth_size_;
+  const cv::Size color_size_;
+  std::ofstream csv_;
+  std::optional<PixelFormat> color_format_;  // set by start(), from the first written frame
+  std::optional<FrameEntry> previous_;
+};
+
+StageDescriptor describe() {
+  StageDescriptor d;
+  d.type = "recording.image_folder_writer";
+  d.summary = "writes frames as an image-folder recording (PNG files and frames.csv)";
+  d.inputs = {
+      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
+      PortSpec::of<ColorImage>("color", "bgr8, rgb8 (stored as bgr8) or a Bayer mosaic"),
+      PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
+  };
+  d.params = {
+      ParamSpec::path("path", std::nullopt).describe("the recording folder to create"),
+      ParamSpec::path("calibration", std::nullopt)
+          .describe("the rig's calibration file; copied into the folder as rig.calib.json"),
+      ParamSpec::boolean("overwrite", false)
+          .describe("replace the recording in an existing, non-empty folder"),
+      ParamSpec::string("description", "").describe("free text for recording.json"),
+  };
+  d.concurrency = Concurrency::kSerial;
+  d.create = factory<ImageFolderWriter>();
+  return d;
+}
+
+}  // namespace
+
+TILTH_STAGE(describe());
+
+}  // namespace tilth::recording

@@ -1,0 +1,117 @@
+#include "recording_json.h"
+
+#include <array>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "tilth/error.h"
+
+namespace tilth::recording {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr std::array kRecordingColorFormats{PixelFormat::kBgr8, PixelFormat::kBayerRggb8,
+                                            PixelFormat::kBayerBggr8, PixelFormat::kBayerGrbg8,
+                                            PixelFormat::kBayerGbrg8};
+
+std::string shortened(const json& value) {
+  std::string text = value.dump();
+  return text.size() > 60 ? text.substr(0, 57) + "..." : text;
+}
+
+[[noreturn]] void fail(const fs::path& file, const std::string& pointer,
+                       const std::string& expected, const json& got) {
+  throw Error(file.string() + ":" + pointer + ": expected " + expected + ", got " + shortened(got));
+}
+
+const json& required(const json& document, const fs::path& file, const std::string& key) {
+  const auto it = document.find(key);
+  if (it == document.end()) throw Error(file.string() + ":/" + key + ": missing required field");
+  return *it;
+}
+
+RigCalibration read_calibration(const json& value, const fs::path& folder, const fs::path& file) {
+  if (value.is_object()) return parse_calibration(value, file.string() + ":/calibration");
+  if (!value.is_string() || value.get<std::string>().empty()) {
+    fail(file, "/calibration",
+         "a calibration file name relative to the folder, or a calibration object", value);
+  }
+  return load_calibration(folder / value.get<std::string>());
+}
+
+}  // namespace
+
+bool is_recording_color_format(PixelFormat format) {
+  for (PixelFormat allowed : kRecordingColorFormats) {
+    if (allowed == format) return true;
+  }
+  return false;
+}
+
+std::string recording_color_formats() {
+  std::string names;
+  for (PixelFormat format : kRecordingColorFormats) {
+    names += (names.empty() ? "" : ", ") + std::string(to_string(format));
+  }
+  return names;
+}
+
+RecordingJson read_recording_json(const fs::path& folder) {
+  const fs::path file = folder / "recording.json";
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot read (is this a recording folder?)");
+  json document;
+  try {
+    document = json::parse(in);
+  } catch (const json::parse_error& error) {
+    throw Error(file.string() + ": malformed JSON: " + error.what());
+  }
+  if (!document.is_object()) fail(file, "", "an object", document);
+  for (const auto& [key, value] : document.items()) {
+    if (key != "format" && key != "calibration" && key != "color_format" && key != "description") {
+      throw Error(file.string() + ":/" + key + ": no such field (misspelt?)");
+    }
+  }
+
+  const json& format = required(document, file, "format");
+  if (format != std::string(kFormat))
+    fail(file, "/format", "\"" + std::string(kFormat) + "\"", format);
+
+  RecordingJson recording;
+  const json& color_format = required(document, file, "color_format");
+  const auto parsed =
+      color_format.is_string() ? parse_pixel_format(color_format.get<std::string>()) : std::nullopt;
+  if (!parsed || !is_recording_color_format(*parsed)) {
+    fail(file, "/color_format", "one of " + recording_color_formats(), color_format);
+  }
+  recording.color_format = *parsed;
+
+  if (const auto it = document.find("description"); it != document.end()) {
+    if (!it->is_string()) fail(file, "/description", "a string", *it);
+    recording.description = it->get<std::string>();
+  }
+  recording.calibration = read_calibration(required(document, file, "calibration"), folder, file);
+  return recording;
+}
+
+void write_recording_json(const fs::path& folder, const std::string& calibration_file,
+                          PixelFormat color_format, const std::string& description) {
+  const json document = {{"format", std::string(kFormat)},
+                         {"calibration", calibration_file},
+                         {"color_format", std::string(to_string(color_format))},
+                         {"description", description}};
+  const fs::path file = folder / "recording.json";
+  const fs::path temporary = folder / "recording.json.tmp";
+  {
+    std::ofstream out(temporary);
+    out << document.dump(2) << "\n";
+    out.close();
+    if (!out) throw Error(temporary.string() + ": cannot write");
+  }
+  fs::rename(temporary, file);
+}
+
+}  // namespace tilth::recording

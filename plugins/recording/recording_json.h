@@ -1,0 +1,34 @@
+// recording.json of an image-folder recording (spec: tilth-image-folder/1): reading and
+// checking it, writing it, and the colour formats the format allows.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "tilth/calibration.h"
+#include "tilth/messages/color_image.h"
+
+namespace tilth::recording {
+
+inline constexpr std::string_view kFormat = "tilth-image-folder/1";
+
+struct RecordingJson {
+  RigCalibration calibration;
+  PixelFormat color_format = PixelFormat::kBgr8;
+  std::string description;
+};
+
+// Reads <folder>/recording.json, and the calibration file it names; throws tilth::Error
+// naming the file and field and what was expected.
+RecordingJson read_recording_json(const std::filesystem::path& folder);
+
+// Writes <folder>/recording.json (through a temporary file, so it is never half-written),
+// referring to the calibration by its file name in the folder.
+void write_recording_json(const std::filesystem::path& folder, const std::string& calibration_file,
+                          PixelFormat color_format, const std::string& description);
+
+// bgr8 and the four Bayer mosaics; rgb8 and mono8 are not recording formats.
+bool is_recording_color_format(PixelFormat format);
+std::string recording_color_formats();  // "bgr8, bayer_rggb8, ..."
+
+}  // namespace tilth::recording

@@ -1,0 +1,342 @@
+// registration.projective: for each depth pixel (u, v) with depth z (mm from the
+// mounting surface) the ToF-frame point P_d = (z + z_offset_mm) * (x', y', 1), (x', y')
+// its undistorted normalised coordinates, is moved into the colour camera,
+// P_c = R * P_d + T, projected with the colour camera's intrinsics and distortion, and
+// the colour there is copied to (u, v). No linearisation (the paper's eqs. 4-5), so a
+// rotated rig and lens distortion are handled; see docs/registration.md.
+//
+//   depth (DepthImage) ──┐
+//                        ├─► registration.projective ─► color (RegisteredColor)
+//   color (ColorImage) ──┘
+//
+// Invariant: a pixel gets a colour only when its status is kValid; every other pixel is
+// black and says why: kNoDepth (NaN depth), kOutsideColor (behind the colour camera or
+// outside its image), kOccluded (the colour camera sees a nearer point there).
+//
+// Occlusion is a z-buffer over the colour image, in cells just large enough that a
+// surface seen by both cameras leaves none empty (OcclusionCells): a first pass keeps the
+// nearest point of each cell, and in the second a point more than occlusion_tolerance_mm
+// behind it is occluded. The depth pixels are projected once, in the first pass.
+//
+//   {"type": "registration.projective",
+//    "params": {"calibration": "rig.calib.json", "occlusion_tolerance_mm": 10,
+//               "interpolation": "nearest"}}
+#include "projective.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "color_sampler.h"
+#include "depth_to_color.h"
+#include "tilth/error.h"
+#include "tilth/message_pool.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/registered_color.h"
+#include "tilth/plugin.h"
+
+namespace tilth::registration {
+namespace {
+
+constexpr int kLanes = 4;  // cv::v_float32x4
+
+std::string size_text(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height) + " px";
+}
+
+// The z-buffer's cells: squares of the colour image just large enough that the depth
+// pixels of a surface seen by both cameras leave none empty. A depth pixel spans about
+// d = fx_c / fx_d colour pixels, and the samples of a surface form a lattice of spacing d
+// at any rotation, which leaves points up to d / sqrt(2) from the nearest sample: a cell
+// of side sqrt(2) d always holds one.
+struct OcclusionCells {
+  explicit OcclusionCells(const RigCalibration& rig)
+      : size(static_cast<int>(std::ceil(
+            std::sqrt(2.0) * std::max(rig.color.fx / rig.depth.fx, rig.color.fy / rig.depth.fy)))),
+        columns((rig.color.width + size - 1) / size),
+        rows((rig.color.height + size - 1) / size) {}
+
+  int size;
+  int columns;
+  int rows;
+};
+
+// One row of located depth pixels, as plain pointers: the registration writes bytes, and
+// through a byte pointer the compiler must assume any memory changed, so everything read
+// per pixel is held in locals, not reached through objects.
+struct LocatedRow {
+  const float* u;  // colour pixel
+  const float* v;
+  const float* depth_mm;  // along the colour axis; NaN: not in the colour image
+  const int* offset;      // of the nearest colour pixel in the colour image, in bytes
+  const int* cell;        // -1: not in the colour image
+};
+
+// What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
+// colour camera sees them (located once, read by both passes), and the demosaiced colour
+// image.
+struct Scratch {
+  cv::Mat nearest_mm;  // CV_32FC1 per cell: the nearest depth along the colour axis
+  std::vector<float> color_u, color_v, color_depth;  // rows of DepthToColor::row_capacity()
+  std::vector<int> offset, cell;
+  cv::Mat demosaiced;  // CV_8UC3, from a Bayer mosaic
+
+  void prepare(const DepthToColor& map, const OcclusionCells& cells) {
+    const auto n = static_cast<std::size_t>(map.row_capacity()) * map.depth_height();
+    for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(n);
+    for (auto* values : {&offset, &cell}) values->resize(n);
+    reuse_or_create(nearest_mm, cells.rows, cells.columns, CV_32FC1);
+    nearest_mm.setTo(std::numeric_limits<float>::infinity());
+  }
+
+  LocatedRow row(const DepthToColor& map, int v) const {
+    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
+    return {color_u.data() + start, color_v.data() + start, color_depth.data() + start,
+            offset.data() + start, cell.data() + start};
+  }
+
+  // Projects depth row `v` and finds each point's nearest colour pixel (as its byte
+  // offset in an image of `step` bytes per row and `pixel_bytes` per pixel; int32 holds
+  // any image below 2 GB) and its cell.
+  LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                    int v, std::ptrdiff_t step, int pixel_bytes) {
+    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
+    float* const u_row = color_u.data() + start;
+    float* const v_row = color_v.data() + start;
+    float* const depth_row = color_depth.data() + start;
+    int* const offset_row = offset.data() + start;
+    int* const cell_row = cell.data() + start;
+    map.project_row(v, depth.ptr<float>(v), u_row, v_row, depth_row);
+    using cv::v_float32x4;
+    using cv::v_int32x4;
+    const v_float32x4 half = cv::v_setall_f32(0.5f);
+    const v_float32x4 per_cell = cv::v_setall_f32(1.0f / static_cast<float>(cells.size));
+    const v_int32x4 columns = cv::v_setall_s32(cells.columns);
+    const v_int32x4 row_bytes = cv::v_setall_s32(static_cast<int>(step));
+    const v_int32x4 bytes = cv::v_setall_s32(pixel_bytes);
+    const v_int32x4 none = cv::v_setall_s32(-1);
+    for (int i = 0; i < map.row_capacity(); i += kLanes) {
+      // Shown points have 0 <= u + 0.5 < width (DepthToColor::kEdgeMarginPx): truncation
+      // rounds to the nearest pixel, and floor((u + 0.5) / size) is the cell.
+      const v_float32x4 x = cv::v_load(u_row + i) + half;
+      const v_float32x4 y = cv::v_load(v_row + i) + half;
+      const v_float32x4 depth_mm = cv::v_load(depth_row + i);
+      cv::v_store(offset_row + i, cv::v_trunc(y) * row_bytes + cv::v_trunc(x) * bytes);
+      const v_int32x4 index =
+          cv::v_muladd(cv::v_trunc(y * per_cell), columns, cv::v_trunc(x * per_cell));
+      const v_int32x4 shown = cv::v_reinterpret_as_s32(depth_mm == depth_mm);  // not NaN
+      cv::v_store(cell_row + i, cv::v_select(shown, index, none));
+    }
+    return row(map, v);
+  }
+};
+
+template <bool kBilinear, class Sampler>
+Bgr sample(const Sampler& sampler, const LocatedRow& row, int i, int width, int height) {
+  if constexpr (!kBilinear) {
+    return sampler.at(row.offset[i]);
+  } else {
+    const float u = row.u[i];
+    const float v = row.v[i];
+    // u, v >= -0.5: truncation of u + 1 is floor(u) + 1. Weights in 1/256.
+    const int x0 = static_cast<int>(u + 1.0f) - 1;
+    const int y0 = static_cast<int>(v + 1.0f) - 1;
+    const int wx = static_cast<int>((u - static_cast<float>(x0)) * 256.0f + 0.5f);
+    const int wy = static_cast<int>((v - static_cast<float>(y0)) * 256.0f + 0.5f);
+    // The neighbours, clamped to the image.
+    const std::ptrdiff_t top_left = sampler.offset(std::max(x0, 0), std::max(y0, 0));
+    const std::ptrdiff_t right = x0 >= 0 && x0 + 1 < width ? Sampler::kPixelBytes : 0;
+    const std::ptrdiff_t down = y0 >= 0 && y0 + 1 < height ? sampler.step() : 0;
+    const Bgr a = sampler.at(top_left);
+    const Bgr b = sampler.at(top_left + right);
+    const Bgr c = sampler.at(top_left + down);
+    const Bgr d = sampler.at(top_left + down + right);
+    const auto blend = [&](int ca, int cb, int cc, int cd) {
+      const int upper = ca * (256 - wx) + cb * wx;
+      const int lower = cc * (256 - wx) + cd * wx;
+      return (upper * (256 - wy) + lower * wy + (1 << 15)) >> 16;
+    };
+    return {blend(a.b, b.b, c.b, d.b), blend(a.g, b.g, c.g, d.g), blend(a.r, b.r, c.r, d.r)};
+  }
+}
+
+template <bool kBilinear, class Sampler>
+void register_frame(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                    const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
+                    RegisteredColor& out) {
+  scratch.prepare(map, cells);
+  const Sampler colors = sampler;  // a local: see LocatedRow
+  float* const nearest_mm = scratch.nearest_mm.ptr<float>();
+  const int width = map.depth_width();
+  const int height = map.depth_height();
+  const int color_width = map.color_width();
+  const int color_height = map.color_height();
+
+  for (int v = 0; v < height; ++v) {  // the nearest point of each cell
+    const LocatedRow row =
+        scratch.locate(map, cells, depth, v, colors.step(), Sampler::kPixelBytes);
+    for (int u = 0; u < width; ++u) {
+      const int cell = row.cell[u];
+      if (cell >= 0) nearest_mm[cell] = std::min(nearest_mm[cell], row.depth_mm[u]);
+    }
+  }
+
+  for (int v = 0; v < height; ++v) {
+    const LocatedRow row = scratch.row(map, v);
+    const auto* z = depth.ptr<float>(v);
+    auto* status = out.status.ptr<std::uint8_t>(v);
+    auto* bgr = out.bgr.ptr<std::uint8_t>(v);
+    for (int u = 0; u < width; ++u) {
+      Bgr color{0, 0, 0};
+      const int cell = row.cell[u];
+      if (cell < 0) {
+        status[u] = std::isnan(z[u]) ? RegisteredColor::kNoDepth : RegisteredColor::kOutsideColor;
+      } else if (row.depth_mm[u] > nearest_mm[cell] + occlusion_tolerance_mm) {
+        status[u] = RegisteredColor::kOccluded;
+      } else {
+        status[u] = RegisteredColor::kValid;
+        color = sample<kBilinear>(colors, row, u, color_width, color_height);
+      }
+      bgr[3 * u] = static_cast<std::uint8_t>(color.b);
+      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g);
+      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r);
+    }
+  }
+}
+
+class ProjectiveRegistration final : public Transform {
+ public:
+  explicit ProjectiveRegistration(const StageContext& context)
+      : ProjectiveRegistration(context, context.params.path("calibration").string()) {}
+
+  void process(Frame& frame) override {
+    const cv::Mat& depth = frame.input<DepthImage>(0).mm;
+    const ColorImage& color = frame.input<ColorImage>(1);
+    check(depth, color);
+
+    auto out = outputs_.acquire();
+    reuse_or_create(out->bgr, map_.depth_height(), map_.depth_width(), CV_8UC3);
+    reuse_or_create(out->status, map_.depth_height(), map_.depth_width(), CV_8UC1);
+    const auto scratch = scratch_.acquire();
+    const auto run = [&](const auto& sampler) {
+      if (bilinear_) {
+        register_frame<true>(map_, cells_, depth, sampler, occlusion_tolerance_mm_, *scratch, *out);
+      } else {
+        register_frame<false>(map_, cells_, depth, sampler, occlusion_tolerance_mm_, *scratch,
+                              *out);
+      }
+    };
+    // OpenCV's SIMD demosaicing of the whole image costs less than demosaicing only the
+    // pixels read, one at a time.
+    const auto run_demosaiced = [&](int code) {
+      cv::cvtColor(color.pixels, scratch->demosaiced, code);
+      run(BgrSampler(scratch->demosaiced));
+    };
+    switch (color.format) {
+      case PixelFormat::kBgr8:
+        run(BgrSampler(color.pixels));
+        break;
+      case PixelFormat::kRgb8:
+        run(RgbSampler(color.pixels));
+        break;
+      case PixelFormat::kMono8:
+        run(MonoSampler(color.pixels));
+        break;
+      // OpenCV names a mosaic by its second row's second and third pixels, one pixel
+      // off the usual naming by the top-left 2x2 tile.
+      case PixelFormat::kBayerRggb8:
+        run_demosaiced(cv::COLOR_BayerBG2BGR);
+        break;
+      case PixelFormat::kBayerBggr8:
+        run_demosaiced(cv::COLOR_BayerRG2BGR);
+        break;
+      case PixelFormat::kBayerGrbg8:
+        run_demosaiced(cv::COLOR_BayerGB2BGR);
+        break;
+      case PixelFormat::kBayerGbrg8:
+        run_demosaiced(cv::COLOR_BayerGR2BGR);
+        break;
+    }
+    frame.set_output(0, std::move(out));
+  }
+
+ private:
+  ProjectiveRegistration(const StageContext& context, std::string file)
+      : ProjectiveRegistration(context, file, load_calibration(file)) {}
+  ProjectiveRegistration(const StageContext& context, const std::string& file,
+                         const RigCalibration& rig)
+      : file_(file),
+        map_(rig, file),
+        cells_(rig),
+        occlusion_tolerance_mm_(
+            static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
+        bilinear_(context.params.string("interpolation") == "bilinear") {}
+
+  void check(const cv::Mat& depth, const ColorImage& color) const {
+    if (depth.type() != CV_32FC1) {
+      throw Error("depth image has pixel type " + cv::typeToString(depth.type()) +
+                  "; expected CV_32FC1 (mm)");
+    }
+    if (depth.cols != map_.depth_width() || depth.rows != map_.depth_height()) {
+      throw Error("depth image is " + size_text(depth.cols, depth.rows) + " but the calibration " +
+                  file_ + " is for " + size_text(map_.depth_width(), map_.depth_height()));
+    }
+    const int expected_type = CV_8UC(channels(color.format));
+    if (color.pixels.type() != expected_type) {
+      throw Error("colour image (" + std::string(to_string(color.format)) + ") has pixel type " +
+                  cv::typeToString(color.pixels.type()) + "; expected " +
+                  cv::typeToString(expected_type));
+    }
+    if (color.pixels.cols != map_.color_width() || color.pixels.rows != map_.color_height()) {
+      throw Error("colour image is " + size_text(color.pixels.cols, color.pixels.rows) +
+                  " but the calibration " + file_ + " is for " +
+                  size_text(map_.color_width(), map_.color_height()));
+    }
+  }
+
+  const std::string file_;
+  const DepthToColor map_;
+  const OcclusionCells cells_;
+  const float occlusion_tolerance_mm_;
+  const bool bilinear_;
+  MessagePool<RegisteredColor> outputs_;
+  MessagePool<Scratch> scratch_;  // one per frame in flight
+};
+
+}  // namespace
+
+StageDescriptor describe_projective() {
+  StageDescriptor d;
+  d.type = "registration.projective";
+  d.summary =
+      "colour resampled onto the depth grid (full projective mapping, lens distortion, "
+      "occlusion)";
+  d.inputs = {
+      PortSpec::of<DepthImage>("depth", "mm from the mounting surface; NaN = no depth"),
+      PortSpec::of<ColorImage>("color", "bgr8, rgb8, mono8 or 8-bit Bayer"),
+  };
+  d.outputs = {PortSpec::of<RegisteredColor>("color", "bgr on the depth grid, status per pixel")};
+  d.params = {
+      ParamSpec::path("calibration", std::nullopt).describe("rig calibration file"),
+      ParamSpec::number("occlusion_tolerance_mm", 10.0)
+          .range(0, std::nullopt)
+          .in_unit("mm")
+          .describe("a point this much farther than the nearest one seen at the same colour "
+                    "pixels is occluded"),
+      ParamSpec::choice("interpolation", {"nearest", "bilinear"}, "nearest")
+          .describe("colour sampling: nearest keeps measured colours, bilinear blends four"),
+  };
+  d.concurrency = Concurrency::kParallel;
+  d.create = factory<ProjectiveRegistration>();
+  return d;
+}
+
+TILTH_STAGE(describe_projective());
+
+}  // namespace tilth::registration

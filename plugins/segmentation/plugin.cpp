@@ -1,0 +1,4 @@
+// Segmentation: which depth pixels show soil. One stage per file.
+#include "tilth/plugin.h"
+
+TILTH_PLUGIN("segmentation")

@@ -1,0 +1,181 @@
+#include "soil_scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace tilth::synthetic {
+namespace {
+
+// Reflectances (BGR) of the materials; soil is brown, straw beige-yellow, wet straw dark
+// and close to the soil's hue.
+const cv::Vec3f kSoil(0.16f, 0.23f, 0.32f);
+const cv::Vec3f kStraw(0.38f, 0.70f, 0.82f);
+const cv::Vec3f kWetStraw(0.14f, 0.22f, 0.30f);
+const cv::Vec3f kStubble(0.32f, 0.60f, 0.72f);
+
+cv::Vec3b to_bytes(const cv::Vec3f& reflectance) {
+  return {cv::saturate_cast<std::uint8_t>(reflectance[0] * 255.0f),
+          cv::saturate_cast<std::uint8_t>(reflectance[1] * 255.0f),
+          cv::saturate_cast<std::uint8_t>(reflectance[2] * 255.0f)};
+}
+
+}  // namespace
+
+SoilScene::SoilScene(const ScenePreset& preset, double soil_z_mm, cv::Rect2d area, double cell_mm,
+                     std::uint64_t seed)
+    : soil_z_(static_cast<float>(soil_z_mm)), area_(area), cell_mm_(cell_mm) {
+  const int cols = static_cast<int>(std::ceil(area.width / cell_mm));
+  const int rows = static_cast<int>(std::ceil(area.height / cell_mm));
+  cv::RNG rng(seed);
+  soil_height_.create(rows, cols, CV_32FC1);
+  material_ = cv::Mat(rows, cols, CV_8UC1, cv::Scalar(static_cast<int>(Material::kSoil)));
+  albedo_.create(rows, cols, CV_8UC3);
+  add_soil(preset, rng);
+  height_ = soil_height_.clone();
+  add_stubble(preset, rng);
+  add_straws(preset, rng);
+  double highest = 0.0;
+  cv::minMaxLoc(height_, nullptr, &highest);
+  top_z_ = soil_z_ - static_cast<float>(highest);
+}
+
+float SoilScene::soil_z(double x, double y) const {
+  const int c = cell_x(x);
+  const int r = cell_y(y);
+  if (c < 0 || r < 0 || c >= soil_height_.cols || r >= soil_height_.rows) return soil_z_;
+  return soil_z_ - soil_height_.at<float>(r, c);
+}
+
+Material SoilScene::material(double x, double y) const {
+  const int c = cell_x(x);
+  const int r = cell_y(y);
+  if (c < 0 || r < 0 || c >= material_.cols || r >= material_.rows) return Material::kSoil;
+  return static_cast<Material>(material_.at<std::uint8_t>(r, c));
+}
+
+cv::Vec3f SoilScene::albedo(double x, double y) const {
+  const int c = std::clamp(cell_x(x), 0, albedo_.cols - 1);
+  const int r = std::clamp(cell_y(y), 0, albedo_.rows - 1);
+  const cv::Vec3b bytes = albedo_.at<cv::Vec3b>(r, c);
+  return {bytes[0] / 255.0f, bytes[1] / 255.0f, bytes[2] / 255.0f};
+}
+
+// Micro-relief: a few sinusoids with wavelengths of 15-80 mm (many periods over a region
+// of interest, so its mean there is the datum) plus fine roughness; soil colour varies
+// slowly with clods and moisture. On the track, layers of soil of the preset's
+// thicknesses follow one another along x.
+void SoilScene::add_soil(const ScenePreset& preset, cv::RNG& rng) {
+  struct Wave {
+    double kx, ky, phase, amplitude;
+  };
+  std::vector<Wave> waves;
+  for (int i = 0; i < 6; ++i) {
+    const double wavelength = rng.uniform(15.0, 80.0);
+    const double angle = rng.uniform(0.0, CV_PI);
+    waves.push_back({2 * CV_PI / wavelength * std::cos(angle),
+                     2 * CV_PI / wavelength * std::sin(angle), rng.uniform(0.0, 2 * CV_PI),
+                     preset.relief_mm / 3.0});
+  }
+  cv::Mat roughness(soil_height_.size(), CV_32FC1);
+  rng.fill(roughness, cv::RNG::NORMAL, 0.0, preset.relief_mm * 0.15);
+  cv::Mat tint(soil_height_.size(), CV_32FC1);
+  rng.fill(tint, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(tint, tint, cv::Size(0, 0), 6.0 / cell_mm_);
+  cv::normalize(tint, tint, -0.18, 0.18, cv::NORM_MINMAX);
+  const double segment =
+      preset.layers_mm.empty()
+          ? 0.0
+          : preset.track_length_mm / static_cast<double>(preset.layers_mm.size());
+  for (int r = 0; r < soil_height_.rows; ++r) {
+    const double y = area_.y + (r + 0.5) * cell_mm_;
+    for (int c = 0; c < soil_height_.cols; ++c) {
+      const double x = area_.x + (c + 0.5) * cell_mm_;
+      double h = roughness.at<float>(r, c);
+      for (const auto& wave : waves)
+        h += wave.amplitude * std::sin(wave.kx * x + wave.ky * y + wave.phase);
+      if (segment > 0.0) {
+        const int layer = std::clamp(static_cast<int>(std::floor(x / segment)), 0,
+                                     static_cast<int>(preset.layers_mm.size()) - 1);
+        h += preset.layers_mm[layer];
+      }
+      soil_height_.at<float>(r, c) = static_cast<float>(h);
+      albedo_.at<cv::Vec3b>(r, c) = to_bytes(kSoil * (1.0f + tint.at<float>(r, c)));
+    }
+  }
+}
+
+// Standing stalks: discs of 3-5 mm diameter, 60-70 mm high (cut wheat stubble).
+void SoilScene::add_stubble(const ScenePreset& preset, cv::RNG& rng) {
+  for (int i = 0; i < preset.stubble; ++i) {
+    const double cx = rng.uniform(area_.x, area_.x + area_.width);
+    const double cy = rng.uniform(area_.y, area_.y + area_.height);
+    const double radius = rng.uniform(1.5, 2.5);
+    const double top = preset.stubble_height_mm + rng.uniform(-5.0, 5.0);
+    const float shade = static_cast<float>(rng.uniform(0.85, 1.1));
+    for (int r = cell_y(cy - radius); r <= cell_y(cy + radius); ++r) {
+      for (int c = cell_x(cx - radius); c <= cell_x(cx + radius); ++c) {
+        if (r < 0 || c < 0 || r >= height_.rows || c >= height_.cols) continue;
+        const double x = area_.x + (c + 0.5) * cell_mm_ - cx;
+        const double y = area_.y + (r + 0.5) * cell_mm_ - cy;
+        if (x * x + y * y > radius * radius) continue;
+        const float h = soil_height_.at<float>(r, c) + static_cast<float>(top);
+        if (h <= height_.at<float>(r, c)) continue;
+        height_.at<float>(r, c) = h;
+        material_.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(Material::kStubble);
+        albedo_.at<cv::Vec3b>(r, c) = to_bytes(kStubble * shade);
+      }
+    }
+  }
+}
+
+// Lying straws: cylinders of 3-6 mm diameter and 40-250 mm length at random angles.
+// Each rests on the soil or the highest straw under its axis, so straws stack where
+// they cross; standing stubble pokes through them rather than holding them up (a
+// height field cannot show a straw floating on a stalk).
+void SoilScene::add_straws(const ScenePreset& preset, cv::RNG& rng) {
+  const cv::Vec3f colour = preset.wet_straw ? kWetStraw : kStraw;
+  cv::Mat lying = soil_height_.clone();
+  for (int i = 0; i < preset.straws; ++i) {
+    const double cx = rng.uniform(area_.x, area_.x + area_.width);
+    const double cy = rng.uniform(area_.y, area_.y + area_.height);
+    const double angle = rng.uniform(0.0, CV_PI);
+    const double half = rng.uniform(20.0, 125.0);
+    const double radius = rng.uniform(1.5, 3.0);
+    const float shade = static_cast<float>(rng.uniform(0.8, 1.15));
+    const double ux = std::cos(angle);
+    const double uy = std::sin(angle);
+    double base = 0.0;
+    for (double s = -half; s <= half; s += cell_mm_) {
+      const int c = cell_x(cx + s * ux);
+      const int r = cell_y(cy + s * uy);
+      if (r >= 0 && c >= 0 && r < lying.rows && c < lying.cols) {
+        base = std::max(base, static_cast<double>(lying.at<float>(r, c)));
+      }
+    }
+    const double extent = half + radius;
+    for (int r = cell_y(cy - extent); r <= cell_y(cy + extent); ++r) {
+      for (int c = cell_x(cx - extent); c <= cell_x(cx + extent); ++c) {
+        if (r < 0 || c < 0 || r >= height_.rows || c >= height_.cols) continue;
+        const double x = area_.x + (c + 0.5) * cell_mm_ - cx;
+        const double y = area_.y + (r + 0.5) * cell_mm_ - cy;
+        const double along = x * ux + y * uy;
+        const double across = -x * uy + y * ux;
+        if (std::abs(along) > half || std::abs(across) >= radius) continue;
+        const float h =
+            static_cast<float>(base + radius + std::sqrt(radius * radius - across * across));
+        lying.at<float>(r, c) = std::max(lying.at<float>(r, c), h);
+        if (h <= height_.at<float>(r, c)) continue;
+        height_.at<float>(r, c) = h;
+        material_.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(Material::kStraw);
+        // Rounded straw is darker towards its sides.
+        const float side =
+            static_cast<float>(0.75 + 0.25 * std::sqrt(1.0 - across * across / (radius * radius)));
+        albedo_.at<cv::Vec3b>(r, c) = to_bytes(colour * (shade * side));
+      }
+    }
+  }
+}
+
+}  // namespace tilth::synthetic

@@ -1,0 +1,197 @@
+// estimation.ground_plane: tilted planes with noise and outliers (tilt, distance at the
+// tool point, spread), a distorted lens, agreement with the median on flat soil, the
+// validity rules and parameter errors.
+//
+// Tolerances. With the defaults (stride 4 in the middle 320x240 of 640x480) about 4800
+// points are fitted; with 1 mm noise and 20 % outliers some 3840 are inliers, spanning
+// X +-170 mm (standard deviation 98 mm) and Y +-127 mm (73 mm) at 540 mm. The standard
+// error of a slope is then sigma / (sqrt(N) std) <= 1 / (62 * 73) = 2.2e-4 rad = 0.013 deg,
+// and of the depth near the region's centre sigma / sqrt(N) = 0.016 mm. The outliers lie
+// 20-80 mm off the plane (20+ sigma beyond the 10 mm threshold), so none is kept and none
+// biases the fit. 0.1 deg and 0.1 mm are thus 6-8 standard errors: tight enough that an
+// unweighted or non-robust fit fails (20 % outliers at 50 mm mean pull a plain least-squares
+// fit about 10 mm), loose enough never to fail on a correct one (the noise is seeded).
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "estimators.h"
+#include "stage_harness.h"
+#include "synthetic_ground.h"
+#include "tilth/error.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/ground_distance.h"
+
+namespace tilth::estimation {
+namespace {
+
+using nlohmann::json;
+using testing::GroundScene;
+using testing::TransformHarness;
+
+const std::filesystem::path kPaperRig =
+    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+constexpr double kTiltToleranceDeg = 0.1;
+constexpr double kDistanceToleranceMm = 0.1;
+
+std::shared_ptr<DepthImage> depth_message(const cv::Mat& mm) {
+  auto message = std::make_shared<DepthImage>();
+  message->mm = mm;
+  return message;
+}
+
+json with_calibration(json params, const std::filesystem::path& calibration = kPaperRig) {
+  params["calibration"] = calibration.string();
+  return params;
+}
+
+GroundDistance fit_plane(const cv::Mat& soil_mm, const json& params = json::object()) {
+  TransformHarness stage(describe_ground_plane(), with_calibration(params));
+  return stage.run({depth_message(soil_mm)})[0].get<GroundDistance>();
+}
+
+const DepthCameraCalibration& paper_camera() {
+  static const DepthCameraCalibration camera = load_calibration(kPaperRig).depth;
+  return camera;
+}
+
+GroundScene tilted_scene_with_outliers() {
+  GroundScene scene;
+  scene.tilt_x_deg = 5.0;
+  scene.tilt_y_deg = 3.0;
+  scene.noise_mm = 1.0;
+  scene.outlier_fraction = 0.2;
+  return scene;
+}
+
+TEST(GroundPlane, TiltedPlaneWithOutliers) {
+  const GroundScene scene = tilted_scene_with_outliers();
+  const GroundDistance out = fit_plane(testing::render(scene, paper_camera()));
+
+  ASSERT_TRUE(out.valid) << out.invalid_reason;
+  ASSERT_TRUE(out.tilt_x_deg && out.tilt_y_deg);
+  EXPECT_NEAR(*out.tilt_x_deg, 5.0, kTiltToleranceDeg);
+  EXPECT_NEAR(*out.tilt_y_deg, 3.0, kTiltToleranceDeg);
+  EXPECT_NEAR(out.distance_mm, scene.distance_mm, kDistanceToleranceMm);
+  // The RMS of ~3840 residuals of 1 mm noise: standard error 1 / sqrt(2 N) = 0.011 mm.
+  EXPECT_NEAR(out.spread_mm, scene.noise_mm, 0.05);
+  // Full coverage times the inlier fraction, 0.8 +- 0.018 (three binomial standard errors).
+  EXPECT_NEAR(out.confidence, 0.8 / (1.0 + std::pow(out.spread_mm / 10.0, 2)), 0.018);
+}
+
+TEST(GroundPlane, DistanceIsReadAtTheToolPoint) {
+  const GroundScene scene = tilted_scene_with_outliers();
+  const GroundDistance out =
+      fit_plane(testing::render(scene, paper_camera()), {{"tool_point", {50.0, 30.0}}});
+  ASSERT_TRUE(out.valid) << out.invalid_reason;
+  // 5.2 mm farther than on the axis (50 mm along x at 3 deg, 30 mm along y at 5 deg).
+  EXPECT_NEAR(out.distance_mm, testing::plane_distance_at(scene, 50.0, 30.0), kDistanceToleranceMm);
+}
+
+TEST(GroundPlane, SameFrameSamePlane) {
+  const cv::Mat depth = testing::render(tilted_scene_with_outliers(), paper_camera());
+  const GroundDistance first = fit_plane(depth);
+  const GroundDistance second = fit_plane(depth);
+  EXPECT_EQ(first.distance_mm, second.distance_mm);
+  EXPECT_EQ(first.tilt_x_deg, second.tilt_x_deg);
+  EXPECT_EQ(first.tilt_y_deg, second.tilt_y_deg);
+}
+
+TEST(GroundPlane, UndistortsThroughTheCalibration) {
+  RigCalibration rig = load_calibration(kPaperRig);
+  rig.depth.distortion = {-0.4, 0.15, 0.0, 0.0, 0.0};
+  const auto file = std::filesystem::temp_directory_path() / "tilth_distorted.calib.json";
+  save_calibration(rig, file);
+  GroundScene scene = tilted_scene_with_outliers();
+  const cv::Mat depth = testing::render(scene, rig.depth);
+
+  TransformHarness stage(describe_ground_plane(), with_calibration(json::object(), file));
+  std::filesystem::remove(file);
+  const GroundDistance out = stage.run({depth_message(depth)})[0].get<GroundDistance>();
+  ASSERT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_NEAR(*out.tilt_x_deg, 5.0, kTiltToleranceDeg);
+  EXPECT_NEAR(*out.tilt_y_deg, 3.0, kTiltToleranceDeg);
+  EXPECT_NEAR(out.distance_mm, scene.distance_mm, kDistanceToleranceMm);
+
+  // Read as if the lens had no distortion, the same depths miss the tolerance (by 0.15 deg
+  // in tilt x): the assertions above see whether the stage undistorts.
+  const GroundDistance ignoring = fit_plane(depth);
+  EXPECT_GT(std::abs(*ignoring.tilt_x_deg - 5.0), kTiltToleranceDeg);
+}
+
+// Flat soil with 2 mm noise: the median of ~76 800 depths has a standard error of
+// 0.009 mm, the plane's depth on the axis 0.03 mm; 0.1 mm is three of their combined.
+TEST(GroundPlane, OnFlatSoilAgreesWithTheMedian) {
+  GroundScene scene;
+  scene.noise_mm = 2.0;
+  const cv::Mat depth = testing::render(scene, paper_camera());
+
+  const GroundDistance plane = fit_plane(depth);
+  TransformHarness median_stage(describe_ground_distance());
+  const GroundDistance median = median_stage.run({depth_message(depth)})[0].get<GroundDistance>();
+
+  ASSERT_TRUE(plane.valid && median.valid);
+  EXPECT_NEAR(plane.distance_mm, median.distance_mm, kDistanceToleranceMm);
+  EXPECT_NEAR(plane.distance_mm, scene.distance_mm, kDistanceToleranceMm);
+  EXPECT_NEAR(*plane.tilt_x_deg, 0.0, kTiltToleranceDeg);
+  EXPECT_NEAR(*plane.tilt_y_deg, 0.0, kTiltToleranceDeg);
+  EXPECT_EQ(plane.soil_pixels, median.soil_pixels);
+}
+
+TEST(GroundPlane, TooLittleVisibleSoilIsInvalid) {
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const GroundDistance out = fit_plane(depth);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.invalid_reason, "too little visible soil: 0.0 % of the region of interest < 5.0 %");
+  EXPECT_EQ(out.distance_mm, 0.0);
+  EXPECT_FALSE(out.tilt_x_deg.has_value());
+}
+
+// 70 % of the depths uniform in 300-700 mm: about 30 % + 70 % * 20 / 400 = 33.5 % lie
+// within 10 mm of the soil plane.
+TEST(GroundPlane, TooFewPointsOnThePlaneIsInvalid) {
+  cv::Mat depth = testing::render(GroundScene{}, paper_camera());
+  cv::RNG random(7);
+  for (auto& mm : cv::Mat_<float>(depth)) {
+    if (random.uniform(0.0, 1.0) < 0.7) mm = static_cast<float>(random.uniform(300.0, 700.0));
+  }
+  const GroundDistance out = fit_plane(depth);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.distance_mm, 0.0);
+  EXPECT_TRUE(out.invalid_reason.starts_with("no plane fits the soil: 3")) << out.invalid_reason;
+  EXPECT_TRUE(out.invalid_reason.ends_with(
+      " % of the soil points lie within 10.0 mm of the best plane < 50.0 %"))
+      << out.invalid_reason;
+}
+
+TEST(GroundPlane, ImageOfAnotherCameraIsAnError) {
+  const cv::Mat depth(240, 320, CV_32FC1, cv::Scalar(518.0));
+  try {
+    fit_plane(depth);
+    FAIL() << "expected an error";
+  } catch (const Error& error) {
+    EXPECT_STREQ(error.what(),
+                 "input 'soil_depth': expected a CV_32FC1 640x480 image (the calibration's depth "
+                 "camera), got type 5, 320x240");
+  }
+}
+
+TEST(GroundPlane, ParameterErrorsSayWhatIsExpected) {
+  const auto error = [](const json& params) -> std::string {
+    try {
+      TransformHarness stage(describe_ground_plane(), with_calibration(params));
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "constructed";
+  };
+  EXPECT_EQ(error({{"tool_point", {10.0}}}),
+            "parameter 'tool_point': expected [x_mm, y_mm] in the ToF camera frame, got [10.0]");
+  EXPECT_EQ(error({{"roi", {{"x", 640}, {"y", 0}, {"width", 10}, {"height", 10}}}}),
+            "parameter 'roi': x 640, y 0, 10x10 lies outside the 640x480 depth image");
+}
+
+}  // namespace
+}  // namespace tilth::estimation

@@ -1,0 +1,398 @@
+// recording.image_folder through the real runtime: what it emits for a recording the
+// test writes itself, the exact error for each kind of bad input, skipping or stopping
+// on a missing PNG, pacing, interrupting a paced wait, and looping.
+#include <chrono>
+#include <functional>
+#include <sstream>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "recording_fixture.h"
+
+namespace tilth::testing {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// Source -> capture sink.
+std::string replay_graph(const fs::path& folder, json params = json::object()) {
+  params["path"] = folder.string();
+  const json graph = {{"nodes",
+                       {{"src", {{"type", "recording.image_folder"}, {"params", params}}},
+                        {"out", {{"type", "test.capture"}}}}},
+                      {"edges", json::array({json::array({"src.raw", "out.raw"}),
+                                             json::array({"src.color", "out.color"}),
+                                             json::array({"src.truth", "out.truth"})})},
+                      {"runtime", {{"max_in_flight", 2}}}};
+  return graph.dump();
+}
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+class ImageFolderSourceTest : public RecordingTest {
+ protected:
+  // A valid bgr8 recording of `count` frames with an inline calibration.
+  fs::path record(int count = 5, std::int64_t spacing_ns = 100'000'000) {
+    frames_ = make_frames(count, small_calibration(), 3, spacing_ns);
+    write_recording(folder_, frames_, "bgr8", small_calibration());
+    return folder_;
+  }
+
+  // Replaces one line of frames.csv (1 = the header).
+  void replace_line(std::size_t line, const std::string& text) {
+    std::istringstream in(read_text(folder_ / "frames.csv"));
+    std::string result;
+    std::string current;
+    for (std::size_t number = 1; std::getline(in, current); ++number) {
+      result += (number == line ? text : current) + "\n";
+    }
+    write_text(folder_ / "frames.csv", result);
+  }
+
+  void edit_recording_json(const std::function<void(json&)>& edit) {
+    json document = json::parse(read_text(folder_ / "recording.json"));
+    edit(document);
+    write_text(folder_ / "recording.json", document.dump(2));
+  }
+
+  std::string start_failure() {
+    const std::string prefix = "node 'src' (recording.image_folder) failed to start: ";
+    const std::string error = start_error(replay_graph(folder_));
+    return error.rfind(prefix, 0) == 0 ? error.substr(prefix.size()) : "unexpected: " + error;
+  }
+
+  std::string csv() const { return (folder_ / "frames.csv").string(); }
+  std::string json_file() const { return (folder_ / "recording.json").string(); }
+
+  fs::path folder_ = dir_.path() / "rec";
+  std::vector<TestFrame> frames_;
+};
+
+TEST_F(ImageFolderSourceTest, EmitsEveryPixelTimestampAndTruthOfTheRecording) {
+  record(5);
+  const auto before = std::chrono::system_clock::now();
+  const RunResult result = run(replay_graph(folder_));
+  const auto after = std::chrono::system_clock::now();
+  ASSERT_FALSE(result.failed) << result.failure;
+  ASSERT_EQ(captured_.size(), frames_.size());
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const TestFrame& expected = frames_[i];
+    const Captured& got = captured_[i];
+    EXPECT_EQ(got.info.frame_id, expected.index);
+    EXPECT_EQ(got.info.device_timestamp_ns, expected.depth_timestamp_ns);
+    EXPECT_GE(got.info.host_timestamp_ns, before.time_since_epoch().count());
+    EXPECT_LE(got.info.host_timestamp_ns, after.time_since_epoch().count());
+    EXPECT_TRUE(same_pixels(expected.depth, got.raw->gray));
+    EXPECT_EQ(got.raw->device_timestamp_ns, expected.depth_timestamp_ns);
+    EXPECT_FALSE(got.raw->scale_mm.has_value());
+    EXPECT_TRUE(same_pixels(expected.color, got.color->pixels));
+    EXPECT_EQ(got.color->format, PixelFormat::kBgr8);
+    EXPECT_EQ(got.color->device_timestamp_ns, expected.color_timestamp_ns);
+    ASSERT_NE(got.truth, nullptr);
+    EXPECT_EQ(got.truth->distance_mm, expected.ground_truth_mm);
+    if (expected.mask.empty()) {
+      EXPECT_TRUE(got.truth->residue_mask.empty());
+    } else {
+      EXPECT_TRUE(same_pixels(expected.mask, got.truth->residue_mask));
+    }
+  }
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4, 6, 7, 8}));
+  // The comparisons above did compare values, not two absent truths.
+  EXPECT_EQ(frames_[0].ground_truth_mm, 500.0);
+  EXPECT_EQ(frames_[4].ground_truth_mm, 501.0);
+}
+
+TEST_F(ImageFolderSourceTest, BayerMosaicWithACalibrationFileInTheFolder) {
+  const json calibration = json::parse(read_text(shipped_calibration_file()));
+  frames_ = make_frames(2, calibration, 1);
+  write_recording(folder_, frames_, "bayer_grbg8", "calib/rig.calib.json");
+  fs::create_directories(folder_ / "calib");
+  fs::copy_file(shipped_calibration_file(), folder_ / "calib" / "rig.calib.json");
+  const RunResult result = run(replay_graph(folder_));
+  ASSERT_FALSE(result.failed) << result.failure;
+  ASSERT_EQ(captured_.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(captured_[i].color->format, PixelFormat::kBayerGrbg8);
+    EXPECT_EQ(captured_[i].color->pixels.type(), CV_8UC1);
+    EXPECT_TRUE(same_pixels(frames_[i].color, captured_[i].color->pixels));
+    EXPECT_TRUE(same_pixels(frames_[i].depth, captured_[i].raw->gray));
+    EXPECT_EQ(captured_[i].raw->gray.size(), cv::Size(640, 480));
+  }
+}
+
+TEST_F(ImageFolderSourceTest, TruthIsEmptyWithoutMaskAndGroundTruthColumns) {
+  record(2);
+  write_text(folder_ / "frames.csv",
+             "index,depth_timestamp_ns,color_timestamp_ns,depth,color\n"
+             "3,1000000000,1000400000,depth/000003.png,color/000003.png\n"
+             "4,1100000000,1100400000,depth/000004.png,color/000004.png\n");
+  const RunResult result = run(replay_graph(folder_));
+  ASSERT_FALSE(result.failed) << result.failure;
+  ASSERT_EQ(captured_.size(), 2u);
+  for (const auto& got : captured_) {
+    ASSERT_NE(got.truth, nullptr);
+    EXPECT_FALSE(got.truth->distance_mm.has_value());
+    EXPECT_TRUE(got.truth->residue_mask.empty());
+  }
+}
+
+TEST_F(ImageFolderSourceTest, MissingFilesAreNamed) {
+  record(1);
+  fs::remove(folder_ / "frames.csv");
+  EXPECT_EQ(start_failure(), csv() + ": cannot read (is this a recording folder?)");
+  fs::remove(folder_ / "recording.json");
+  EXPECT_EQ(start_failure(), json_file() + ": cannot read (is this a recording folder?)");
+}
+
+TEST_F(ImageFolderSourceTest, RecordingJsonErrorsNameTheFieldAndWhatWasExpected) {
+  record(1);
+  edit_recording_json([](json& d) { d["format"] = "tilth-image-folder/2"; });
+  EXPECT_EQ(start_failure(), json_file() +
+                                 ":/format: expected \"tilth-image-folder/1\", got "
+                                 "\"tilth-image-folder/2\"");
+
+  edit_recording_json([](json& d) {
+    d["format"] = "tilth-image-folder/1";
+    d["color_format"] = "rgb8";
+  });
+  EXPECT_EQ(start_failure(), json_file() +
+                                 ":/color_format: expected one of bgr8, bayer_rggb8, bayer_bggr8, "
+                                 "bayer_grbg8, bayer_gbrg8, got \"rgb8\"");
+
+  edit_recording_json([](json& d) {
+    d["color_format"] = "bgr8";
+    d["calibration"]["depth_camera"]["fx"] = 0;
+  });
+  EXPECT_EQ(start_failure(),
+            json_file() + ":/calibration:/depth_camera/fx: expected a number > 0, got 0");
+
+  edit_recording_json([](json& d) { d["calibration"] = "missing.calib.json"; });
+  EXPECT_EQ(start_failure(),
+            (folder_ / "missing.calib.json").string() + ": cannot read calibration file");
+
+  edit_recording_json([](json& d) { d["calibration"] = 7; });
+  EXPECT_EQ(start_failure(), json_file() +
+                                 ":/calibration: expected a calibration file name relative to the "
+                                 "folder, or a calibration object, got 7");
+
+  edit_recording_json([](json& d) { d.erase("calibration"); });
+  EXPECT_EQ(start_failure(), json_file() + ":/calibration: missing required field");
+
+  edit_recording_json([](json& d) { d["colour_format"] = "bgr8"; });
+  EXPECT_EQ(start_failure(), json_file() + ":/colour_format: no such field (misspelt?)");
+}
+
+TEST_F(ImageFolderSourceTest, ReferencedCalibrationErrorsNameItsFile) {
+  record(1);
+  json calibration = small_calibration();
+  calibration["depth_camera"]["depth_measure"] = "radial_distance";
+  write_text(folder_ / "rig.calib.json", calibration.dump(2));
+  edit_recording_json([](json& d) { d["calibration"] = "rig.calib.json"; });
+  EXPECT_EQ(start_failure(), (folder_ / "rig.calib.json").string() +
+                                 ":/depth_camera/depth_measure: expected \"radial\" or \"z\", got "
+                                 "\"radial_distance\"");
+}
+
+TEST_F(ImageFolderSourceTest, FramesCsvErrorsNameTheLineAndWhatWasExpected) {
+  const std::string all_columns =
+      "(expected columns index, depth_timestamp_ns, color_timestamp_ns, depth, color and "
+      "optionally mask, ground_truth_mm)";
+  record(4);
+  const std::string header =
+      "index,depth_timestamp_ns,color_timestamp_ns,depth,color,mask,ground_truth_mm";
+  replace_line(1, "index,depth_timestamp_ns,depth,color,mask,ground_truth_mm");
+  EXPECT_EQ(start_failure(),
+            csv() + ":1: missing required column 'color_timestamp_ns' " + all_columns);
+
+  replace_line(1, header + ",exposure_us");
+  EXPECT_EQ(start_failure(), csv() + ":1: unknown column 'exposure_us' " + all_columns);
+
+  replace_line(1, "index,depth,depth_timestamp_ns,color_timestamp_ns,depth,color,mask");
+  EXPECT_EQ(start_failure(), csv() + ":1: column 'depth' appears twice");
+
+  record(4);
+  replace_line(3, "4,11000O0000,1100400000,depth/000004.png,color/000004.png,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":3: column 'depth_timestamp_ns': expected an integer number of "
+                                 "nanoseconds, got '11000O0000'");
+
+  replace_line(3, "-4,1100000000,1100400000,depth/000004.png,color/000004.png,,");
+  EXPECT_EQ(start_failure(),
+            csv() + ":3: column 'index': expected a non-negative integer, got '-4'");
+
+  replace_line(3, "4,1100000000,1100400000,depth/000004.png,color/000004.png,,5l8");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":3: column 'ground_truth_mm': expected a number of millimetres "
+                                 "or nothing, got '5l8'");
+
+  replace_line(3, "4,1100000000,1100400000,depth/000004.png,color/000004.png,");
+  EXPECT_EQ(start_failure(), csv() + ":3: expected 7 fields as in the header, got 6");
+
+  replace_line(3, "4,1100000000,1100400000,,color/000004.png,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":3: column 'depth': expected a file path relative to the "
+                                 "recording folder, got ''");
+}
+
+TEST_F(ImageFolderSourceTest, IndicesAndTimestampsMustIncrease) {
+  record(4);  // lines 2..5: indices 3, 4, 6, 7; depth 1.0 s, 1.1 s, 1.2 s, 1.3 s
+  replace_line(4, "6,1050000000,1200400000,depth/000006.png,color/000006.png,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":4: column 'depth_timestamp_ns': expected a value > 1100000000 "
+                                 "(line 3), got '1050000000'");
+
+  replace_line(4, "6,1200000000,1100400000,depth/000006.png,color/000006.png,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":4: column 'color_timestamp_ns': expected a value > 1100400000 "
+                                 "(line 3), got '1100400000'");
+
+  replace_line(4, "4,1200000000,1200400000,depth/000006.png,color/000006.png,,");
+  EXPECT_EQ(start_failure(), csv() + ":4: column 'index': expected a value > 4 (line 3), got '4'");
+}
+
+// Wrong images stop the stream: the run fails after the frames before it.
+TEST_F(ImageFolderSourceTest, WrongBitDepthSizeOrChannelsStopTheStream) {
+  const std::string prefix = "node 'src' (recording.image_folder) failed: ";
+  const std::string suffix = "; its stream ends here";
+  struct Case {
+    std::string file;
+    cv::Mat image;
+    std::string expected;
+  };
+  const std::vector<Case> cases{
+      {"depth/000004.png", cv::Mat(24, 32, CV_8UC1, cv::Scalar(9)),
+       "expected 16-bit 1-channel, 32x24 pixels (depth_camera in the calibration), got 8-bit "
+       "1-channel, 32x24 pixels"},
+      {"depth/000004.png", cv::Mat(12, 16, CV_16UC1, cv::Scalar(9)),
+       "expected 16-bit 1-channel, 32x24 pixels (depth_camera in the calibration), got 16-bit "
+       "1-channel, 16x12 pixels"},
+      {"color/000004.png", cv::Mat(30, 40, CV_8UC1, cv::Scalar(9)),
+       "expected 8-bit 3-channel, 40x30 pixels (color_camera in the calibration), got 8-bit "
+       "1-channel, 40x30 pixels"},
+      {"color/000004.png", cv::Mat(30, 40, CV_16UC3, cv::Scalar(9, 9, 9)),
+       "expected 8-bit 3-channel, 40x30 pixels (color_camera in the calibration), got 16-bit "
+       "3-channel, 40x30 pixels"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.expected);
+    captured_.clear();
+    record(3);
+    ASSERT_TRUE(cv::imwrite((folder_ / c.file).string(), c.image));
+    const RunResult result = run(replay_graph(folder_));
+    EXPECT_TRUE(result.failed);
+    EXPECT_EQ(result.failure, prefix + (folder_ / c.file).string() +
+                                  " (frames.csv line 3): " + c.expected + suffix);
+    EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3}));
+  }
+
+  captured_.clear();
+  record(3);  // frame 6 (line 4) has a mask
+  ASSERT_TRUE(cv::imwrite((folder_ / "mask/000006.png").string(),
+                          cv::Mat(24, 32, CV_16UC1, cv::Scalar(0))));
+  const RunResult result = run(replay_graph(folder_));
+  EXPECT_EQ(result.failure, prefix + (folder_ / "mask/000006.png").string() +
+                                " (frames.csv line 4): expected 8-bit 1-channel, 32x24 pixels "
+                                "(depth_camera in the calibration), got 16-bit 1-channel, 32x24 "
+                                "pixels" +
+                                suffix);
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4}));
+}
+
+TEST_F(ImageFolderSourceTest, MissingOrUnreadablePngSkipsTheFrameWithAWarning) {
+  record(5);
+  fs::remove(folder_ / "color/000006.png");
+  write_text(folder_ / "depth/000008.png", "not a PNG");
+  const RunResult result = run(replay_graph(folder_, {{"on_missing", "skip"}}));
+  EXPECT_FALSE(result.failed) << result.failure;
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4, 7}));
+  EXPECT_EQ(result.metrics.frames_completed, 3u);
+  const auto logged = warnings();
+  const std::vector<std::string> expected{
+      "src: " + (folder_ / "color/000006.png").string() +
+          " (frames.csv line 4): no such file; frame 6 skipped (on_missing: skip)",
+      "src: " + (folder_ / "depth/000008.png").string() +
+          " (frames.csv line 6): not a readable image; frame 8 skipped (on_missing: skip)"};
+  EXPECT_EQ(logged, expected);
+}
+
+TEST_F(ImageFolderSourceTest, MissingPngStopsWhenAsked) {
+  record(5);
+  fs::remove(folder_ / "color/000006.png");
+  const RunResult result = run(replay_graph(folder_, {{"on_missing", "stop"}}));
+  EXPECT_TRUE(result.failed);
+  EXPECT_EQ(result.failure, "node 'src' (recording.image_folder) failed: " +
+                                (folder_ / "color/000006.png").string() +
+                                " (frames.csv line 4): no such file (on_missing: stop); its "
+                                "stream ends here");
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4}));
+}
+
+// 10 frames 100 ms apart span 0.9 s of recorded time.
+TEST_F(ImageFolderSourceTest, RateOnePacesByTheDepthTimestamps) {
+  record(10);
+  const auto start = Clock::now();
+  const RunResult result = run(replay_graph(folder_, {{"rate", 1}}));
+  EXPECT_GE(seconds_since(start), 0.9);
+  EXPECT_EQ(result.metrics.frames_completed, 10u);
+}
+
+// 10 frames 200 ms apart: 1.8 s recorded, 0.9 s at twice the speed.
+TEST_F(ImageFolderSourceTest, RateTwoPacesTwiceAsFast) {
+  record(10, 200'000'000);
+  const auto start = Clock::now();
+  run(replay_graph(folder_, {{"rate", 2}}));
+  const double elapsed = seconds_since(start);
+  EXPECT_GE(elapsed, 0.9);
+  EXPECT_LT(elapsed, 1.7);
+  EXPECT_EQ(captured_.size(), 10u);
+}
+
+TEST_F(ImageFolderSourceTest, RateZeroDoesNotWait) {
+  record(10, 1'000'000'000);  // 9 s of recorded time
+  const auto start = Clock::now();
+  run(replay_graph(folder_, {{"rate", 0}}));
+  EXPECT_LT(seconds_since(start), 4.5);
+  EXPECT_EQ(captured_.size(), 10u);
+}
+
+TEST_F(ImageFolderSourceTest, StopInterruptsAPacedWait) {
+  record(3, 60'000'000'000);  // a minute between frames
+  auto runtime = make(replay_graph(folder_, {{"rate", 1}}));
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    runtime->stop();
+  });
+  const auto start = Clock::now();
+  const RunResult result = runtime->run();
+  stopper.join();
+  EXPECT_LT(seconds_since(start), 5.0);
+  EXPECT_FALSE(result.failed);
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3}));
+}
+
+TEST_F(ImageFolderSourceTest, LoopStartsAgainAfterTheLastFrame) {
+  record(3);
+  run(replay_graph(folder_, {{"loop", true}}), RunLimits{8});
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4, 6, 3, 4, 6, 3, 4}));
+  EXPECT_TRUE(same_pixels(frames_[1].depth, captured_[7].raw->gray));
+}
+
+TEST_F(ImageFolderSourceTest, LoopEndsWhenNoFrameCanBeRead) {
+  record(2);
+  fs::remove(folder_ / "depth/000003.png");
+  fs::remove(folder_ / "depth/000004.png");
+  const RunResult result = run(replay_graph(folder_, {{"loop", true}}));
+  EXPECT_FALSE(result.failed);
+  EXPECT_TRUE(captured_.empty());
+  ASSERT_EQ(warnings().size(), 3u);
+  EXPECT_EQ(warnings().back(),
+            "src: " + folder_.string() + ": no frame of the recording could be read; not looping");
+}
+
+}  // namespace
+}  // namespace tilth::testing

@@ -1,0 +1,753 @@
+// registration.projective against the tests' own long-double geometry
+// (reference_geometry.h), on synthetic scenes whose depth is computed analytically. The
+// colour image encodes its own pixel coordinates (B = u mod 256, G = v mod 256,
+// R = u / 256 + 16 * (v / 256)), so the registered colour says which colour pixel the
+// stage sampled.
+//
+// Tolerances:
+// - kMappingPx = 0.01 px between the stage's mapping and the reference. The stage maps
+//   in float32: colour coordinates below 2048 px are spaced 1.2e-4 px and the mapping
+//   rounds about ten times, so it stays within about 2e-3 px.
+// - Sampled pixels are compared exactly, except where the reference lies within
+//   kMappingPx of a rounding tie (x.5) or of the image edge, where either answer is
+//   right to within the mapping's accuracy.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <span>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "depth_to_color.h"
+#include "projective.h"
+#include "reference_geometry.h"
+#include "tilth/error.h"
+#include "tilth/frame.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/registered_color.h"
+
+namespace tilth::registration {
+namespace {
+
+namespace fs = std::filesystem;
+namespace ref = reference;
+using nlohmann::json;
+using ref::Real;
+
+constexpr double kMappingPx = 0.01;
+constexpr double kPi = 3.14159265358979323846;
+
+const fs::path kPaperRig = fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+
+json paper_rig() {
+  std::ifstream in(kPaperRig);
+  return json::parse(in);
+}
+
+// A calibration file of this test's own, removed at the end of the test.
+class CalibrationFile {
+ public:
+  explicit CalibrationFile(const json& document)
+      : path_(fs::temp_directory_path() /
+              ("tilth_registration_" +
+               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+               ".calib.json")) {
+    std::ofstream(path_) << document.dump(2);
+  }
+  ~CalibrationFile() { fs::remove(path_); }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// R = Rz(z) Ry(y) Rx(x), angles in degrees.
+json rotation(double x_deg, double y_deg, double z_deg) {
+  const cv::Matx33d rx(1, 0, 0, 0, std::cos(x_deg * kPi / 180), -std::sin(x_deg * kPi / 180), 0,
+                       std::sin(x_deg * kPi / 180), std::cos(x_deg * kPi / 180));
+  const cv::Matx33d ry(std::cos(y_deg * kPi / 180), 0, std::sin(y_deg * kPi / 180), 0, 1, 0,
+                       -std::sin(y_deg * kPi / 180), 0, std::cos(y_deg * kPi / 180));
+  const cv::Matx33d rz(std::cos(z_deg * kPi / 180), -std::sin(z_deg * kPi / 180), 0,
+                       std::sin(z_deg * kPi / 180), std::cos(z_deg * kPi / 180), 0, 0, 0, 1);
+  const cv::Matx33d r = rz * ry * rx;
+  return {{r(0, 0), r(0, 1), r(0, 2)}, {r(1, 0), r(1, 1), r(1, 2)}, {r(2, 0), r(2, 1), r(2, 2)}};
+}
+
+std::unique_ptr<Transform> make_registration(const fs::path& calibration,
+                                             const std::string& interpolation = "nearest",
+                                             double occlusion_tolerance_mm = 10.0) {
+  const StageContext context{"registration",
+                             Params(json{{"calibration", calibration.string()},
+                                         {"occlusion_tolerance_mm", occlusion_tolerance_mm},
+                                         {"interpolation", interpolation}}),
+                             Logger("registration"),
+                             {}};
+  std::unique_ptr<Stage> stage = describe_projective().create(context);
+  auto* transform = dynamic_cast<Transform*>(stage.get());
+  if (transform == nullptr) throw std::logic_error("registration.projective is not a transform");
+  stage.release();
+  return std::unique_ptr<Transform>(transform);
+}
+
+std::shared_ptr<const RegisteredColor> register_color(Transform& stage, const cv::Mat& depth_mm,
+                                                      const cv::Mat& pixels,
+                                                      PixelFormat format = PixelFormat::kBgr8) {
+  DepthImage depth;
+  depth.mm = depth_mm;
+  ColorImage color;
+  color.pixels = pixels;
+  color.format = format;
+  const std::vector<Packet> inputs = {
+      Packet(FrameInfo{}, std::make_shared<const DepthImage>(std::move(depth))),
+      Packet(FrameInfo{}, std::make_shared<const ColorImage>(std::move(color)))};
+  std::vector<Packet> outputs(1);
+  Frame frame(FrameInfo{}, inputs, outputs);
+  stage.process(frame);
+  return outputs[0].share<RegisteredColor>();
+}
+
+cv::Mat coordinate_image(int width = 1280, int height = 1024) {
+  cv::Mat image(height, width, CV_8UC3);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      image.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(static_cast<std::uint8_t>(u % 256), static_cast<std::uint8_t>(v % 256),
+                    static_cast<std::uint8_t>(u / 256 + 16 * (v / 256)));
+    }
+  }
+  return image;
+}
+
+cv::Point decode(const cv::Vec3b& bgr) {
+  return {(bgr[2] % 16) * 256 + bgr[0], (bgr[2] / 16) * 256 + bgr[1]};
+}
+
+std::vector<ref::Vec3> depth_rays(const ref::Rig& rig) {
+  std::vector<ref::Vec3> rays;
+  for (int v = 0; v < rig.depth.height; ++v) {
+    for (int u = 0; u < rig.depth.width; ++u) rays.push_back(ref::depth_ray(rig, u, v));
+  }
+  return rays;
+}
+
+// The depth image (mm from the mounting surface) of the plane through the optical-axis
+// point at distance_mm whose normal is `normal` (ToF frame).
+cv::Mat plane_depth(const ref::Rig& rig, const std::vector<ref::Vec3>& rays, Real distance_mm,
+                    ref::Vec3 normal) {
+  const ref::Vec3 on_plane{0, 0, distance_mm + rig.z_offset};
+  cv::Mat depth(rig.depth.height, rig.depth.width, CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const ref::Vec3 ray = rays[static_cast<std::size_t>(v * depth.cols + u)];
+      depth.at<float>(v, u) =
+          static_cast<float>(ref::dot(normal, on_plane) / ref::dot(normal, ray) - rig.z_offset);
+    }
+  }
+  return depth;
+}
+
+bool near_half(Real x) { return std::abs(x - std::floor(x) - 0.5L) < kMappingPx; }
+
+struct Agreement {
+  int in_image = 0;  // pixels the reference sees inside the colour image
+  int compared = 0;  // of those, sampled pixels compared (not at a rounding tie)
+  int status_mismatches = 0;
+  int sample_mismatches = 0;
+  int colour_on_flagged = 0;  // flagged pixels that are not black
+  double max_mapping_error_px = 0.0;
+};
+
+int coloured_flagged(const RegisteredColor& out) {
+  cv::Mat coloured;
+  cv::transform(out.bgr, coloured, cv::Matx13f(1, 1, 1));  // b + g + r, saturated
+  return cv::countNonZero((out.status != RegisteredColor::kValid) & (coloured > 0));
+}
+
+// The stage's mapping of one row of depth pixels.
+struct MappedRow {
+  std::vector<float> u, v, depth;
+
+  MappedRow(const DepthToColor& map, int row, const float* z_mm)
+      : u(static_cast<std::size_t>(map.row_capacity())), v(u.size()), depth(u.size()) {
+    map.project_row(row, z_mm, u.data(), v.data(), depth.data());
+  }
+};
+
+// Compares a registration of a scene without occlusion, nearest sampling of
+// coordinate_image(), with the reference.
+Agreement compare(const json& document, const fs::path& file, const cv::Mat& depth,
+                  const std::vector<ref::Vec3>& rays, const RegisteredColor& out) {
+  const ref::Rig rig = ref::rig_from(document);
+  const DepthToColor map(load_calibration(file), file.string());
+  const Real right = rig.color.width - 0.5L;
+  const Real bottom = rig.color.height - 0.5L;
+  Agreement a;
+  for (int v = 0; v < depth.rows; ++v) {
+    const MappedRow mapped(map, v, depth.ptr<float>(v));
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      const auto status = out.status.at<std::uint8_t>(v, u);
+      const cv::Vec3b bgr = out.bgr.at<cv::Vec3b>(v, u);
+      if (status != RegisteredColor::kValid && bgr != cv::Vec3b(0, 0, 0)) ++a.colour_on_flagged;
+      if (std::isnan(z)) {
+        a.status_mismatches += status == RegisteredColor::kNoDepth ? 0 : 1;
+        continue;
+      }
+      const int pixel = v * depth.cols + u;
+      const ref::ColorPixel expected = ref::project(rig, rays[static_cast<std::size_t>(pixel)], z);
+      const bool inside = expected.depth > 0 && expected.u >= -0.5L && expected.u < right &&
+                          expected.v >= -0.5L && expected.v < bottom;
+      const bool at_edge =
+          std::min({std::abs(expected.u + 0.5L), std::abs(expected.u - right),
+                    std::abs(expected.v + 0.5L), std::abs(expected.v - bottom)}) < kMappingPx;
+      if (inside) {
+        ++a.in_image;
+        a.max_mapping_error_px = std::max(
+            a.max_mapping_error_px,
+            static_cast<double>(std::hypot(mapped.u[u] - expected.u, mapped.v[u] - expected.v)));
+      }
+      if (at_edge) continue;
+      const auto expected_status =
+          inside ? RegisteredColor::kValid : RegisteredColor::kOutsideColor;
+      a.status_mismatches += status == expected_status ? 0 : 1;
+      if (inside && status == RegisteredColor::kValid && !near_half(expected.u) &&
+          !near_half(expected.v)) {
+        ++a.compared;
+        const cv::Point sampled = decode(bgr);
+        const cv::Point nearest(static_cast<int>(std::floor(expected.u + 0.5L)),
+                                static_cast<int>(std::floor(expected.v + 0.5L)));
+        a.sample_mismatches += sampled == nearest ? 0 : 1;
+      }
+    }
+  }
+  return a;
+}
+
+void expect_agreement(const Agreement& a, int min_in_image) {
+  EXPECT_LT(a.max_mapping_error_px, kMappingPx);
+  EXPECT_EQ(a.status_mismatches, 0);
+  EXPECT_EQ(a.sample_mismatches, 0);
+  EXPECT_EQ(a.colour_on_flagged, 0);
+  EXPECT_GE(a.in_image, min_in_image);
+  // Ties exclude about 2 * 2 * 0.01 of the pixels.
+  EXPECT_GT(a.compared, a.in_image * 9 / 10);
+}
+
+ref::Vec3 tilted_normal() { return {0.18L, -0.36L, 1.0L}; }  // 10 and 20 degrees
+
+TEST(ProjectiveRegistration, TiltedPlaneMatchesTheReferenceProjection) {
+  const json document = paper_rig();
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  const auto out = register_color(*make_registration(kPaperRig), depth, coordinate_image());
+  const Agreement a = compare(document, kPaperRig, depth, rays, *out);
+  // The colour camera sees most of the ToF image: all but a band on the side away
+  // from the baseline.
+  expect_agreement(a, 250000);
+  std::cout << "paper rig, tilted plane: max mapping error " << a.max_mapping_error_px
+            << " px over " << a.in_image << " pixels\n";
+}
+
+TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProjection) {
+  json document = paper_rig();
+  document["depth_to_color"]["R"] = rotation(4, -6, 2);
+  document["depth_to_color"]["T_mm"] = {45.0, -8.0, 5.0};
+  document["depth_camera"]["distortion"] = {-0.12, 0.03, 0.0008, -0.0005, 0.0};
+  document["color_camera"]["distortion"] = {-0.2, 0.08, -0.001, 0.0006, -0.01};
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
+  const Agreement a = compare(document, file.path(), depth, rays, *out);
+  expect_agreement(a, 200000);
+  std::cout << "rotated rig with distortion: max mapping error " << a.max_mapping_error_px
+            << " px over " << a.in_image << " pixels\n";
+}
+
+TEST(ProjectiveRegistration, PixelsOutsideTheColourImageAreFlaggedAndBlack) {
+  json document = paper_rig();
+  document["color_camera"]["fx"] = 1800.0;  // a narrower colour view than the ToF's
+  document["color_camera"]["fy"] = 1800.0;
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  depth(cv::Rect(300, 200, 10, 10)).setTo(std::numeric_limits<float>::quiet_NaN());
+  const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
+  const Agreement a = compare(document, file.path(), depth, rays, *out);
+  expect_agreement(a, 60000);
+  EXPECT_GT(cv::countNonZero(out->status == RegisteredColor::kOutsideColor), 100000);
+  EXPECT_EQ(cv::countNonZero(out->status == RegisteredColor::kNoDepth), 100);
+}
+
+TEST(ProjectiveRegistration, PointsBeyondTheDistortionsFoldAreOutsideNotFoldedIn) {
+  // Barrel distortion r (1 + k1 r^2) turns back at r^2 = -1 / (3 k1); with the colour
+  // camera turned 35 degrees, ToF pixels up to 67 degrees off its axis exist, and the
+  // polynomial maps some of them back into the image.
+  json document = paper_rig();
+  const Real k1 = -0.15L;
+  document["color_camera"]["distortion"] = {static_cast<double>(k1), 0, 0, 0, 0};
+  document["depth_to_color"]["R"] = rotation(0, 35, 0);
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const cv::Mat depth = plane_depth(rig, rays, 518, {0, 0, 1});
+  const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
+  const Real fold_radius2 = -1 / (3 * k1);
+  int beyond_fold = 0;
+  int folded_into_image = 0;
+  int beyond_fold_not_outside = 0;
+  int within_checked = 0;
+  int within_mismatches = 0;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const auto status = out->status.at<std::uint8_t>(v, u);
+      const auto p = ref::project(rig, rays[static_cast<std::size_t>(v * depth.cols + u)],
+                                  depth.at<float>(v, u));
+      const bool lands_inside = p.u >= -0.5L && p.u < rig.color.width - 0.5L && p.v >= -0.5L &&
+                                p.v < rig.color.height - 0.5L;
+      // 1 % margins around the fold: the stage finds it numerically.
+      if (p.radius2 > fold_radius2 * 1.01L) {
+        ++beyond_fold;
+        folded_into_image += lands_inside ? 1 : 0;
+        beyond_fold_not_outside += status == RegisteredColor::kOutsideColor ? 0 : 1;
+      } else if (p.radius2 < fold_radius2 * 0.99L && !near_half(p.u) && !near_half(p.v)) {
+        ++within_checked;
+        const auto expected =
+            lands_inside ? RegisteredColor::kValid : RegisteredColor::kOutsideColor;
+        within_mismatches += status == expected ? 0 : 1;
+      }
+    }
+  }
+  EXPECT_GT(folded_into_image, 1000);  // the case exists in this scene
+  EXPECT_GT(beyond_fold, folded_into_image);
+  EXPECT_EQ(beyond_fold_not_outside, 0);
+  EXPECT_GT(within_checked, 100000);
+  EXPECT_EQ(within_mismatches, 0);
+}
+
+struct BoxOcclusion {
+  int clearly_occluded = 0;  // by the geometry
+  int missed = 0;            // of those, not flagged kOccluded
+  int clearly_visible = 0;
+  int flagged = 0;  // of those, not kValid
+  int coloured_flagged = 0;
+};
+
+// A plane at 518 mm and a 150 mm tall box on it, 120 x 120 mm around the ToF's axis,
+// registered with the rig in `document`. Wherever the colour camera's centre (-R^T T)
+// lies to the side, it cannot see a strip of plane the ToF sees just beyond the box's
+// far edge.
+BoxOcclusion occlusion_by_a_box(const json& document) {
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const Real plane = 518 + rig.z_offset;
+  const ref::Vec3 box_low{-60, -60, plane - 150};
+  const ref::Vec3 box_high{60, 60, plane};
+  const ref::Vec3 origin{0, 0, 0};
+  const ref::Vec3 colour_centre = ref::color_centre(rig);
+
+  cv::Mat depth(rig.depth.height, rig.depth.width, CV_32FC1);
+  // How far behind the first surface the colour camera meets on its way to the point.
+  cv::Mat hidden_mm(depth.size(), CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const ref::Vec3 ray = rays[static_cast<std::size_t>(v * depth.cols + u)];
+      const auto box = ref::enter_box(origin, ray, box_low, box_high);
+      const Real optical_centre_depth = box ? std::min(*box, plane) : plane;
+      depth.at<float>(v, u) = static_cast<float>(optical_centre_depth - rig.z_offset);
+      const ref::Vec3 point = optical_centre_depth * ray;
+      const auto blocked = ref::enter_box(colour_centre, point - colour_centre, box_low, box_high);
+      const Real behind = blocked ? (1 - *blocked) * ref::to_color(rig, point).z : 0;
+      hidden_mm.at<float>(v, u) = static_cast<float>(std::max(behind, Real{0}));
+    }
+  }
+  const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
+
+  // Clearly occluded: hidden by more than the tolerance (10 mm) + 15 mm, as are all
+  // neighbours within 2 pixels. Clearly visible: no neighbour within 3 pixels hidden and
+  // no depth step over the tolerance there. The bands between are where a z-buffer cell
+  // (2 colour pixels, one ToF pixel) straddles the occlusion's edge.
+  BoxOcclusion result;
+  for (int v = 3; v < depth.rows - 3; ++v) {
+    for (int u = 3; u < depth.cols - 3; ++u) {
+      const auto status = out->status.at<std::uint8_t>(v, u);
+      if (status == RegisteredColor::kOutsideColor) continue;
+      double min_hidden = 1e9;
+      double max_hidden = 0;
+      double max_step = 0;
+      for (int dv = -3; dv <= 3; ++dv) {
+        for (int du = -3; du <= 3; ++du) {
+          const float h = hidden_mm.at<float>(v + dv, u + du);
+          if (std::abs(du) <= 2 && std::abs(dv) <= 2) min_hidden = std::min<double>(min_hidden, h);
+          max_hidden = std::max<double>(max_hidden, h);
+          max_step = std::max<double>(
+              max_step, std::abs(depth.at<float>(v + dv, u + du) - depth.at<float>(v, u)));
+        }
+      }
+      if (min_hidden > 10 + 15) {
+        ++result.clearly_occluded;
+        result.missed += status == RegisteredColor::kOccluded ? 0 : 1;
+      } else if (max_hidden < 1e-3 && max_step < 10) {
+        ++result.clearly_visible;
+        result.flagged += status == RegisteredColor::kValid ? 0 : 1;
+      }
+    }
+  }
+  result.coloured_flagged = coloured_flagged(*out);
+  std::cout << cv::countNonZero(out->status == RegisteredColor::kOccluded)
+            << " pixels flagged occluded, " << result.clearly_occluded
+            << " clearly occluded by the geometry\n";
+  return result;
+}
+
+void expect_occlusion_found(const BoxOcclusion& box, int min_occluded) {
+  EXPECT_GE(box.clearly_occluded, min_occluded);  // the scene has the case
+  EXPECT_EQ(box.missed, 0);
+  EXPECT_GT(box.clearly_visible, 200000);
+  EXPECT_EQ(box.flagged, 0);
+  EXPECT_EQ(box.coloured_flagged, 0);
+}
+
+// The expected strip widths: the colour ray over the box's top edge (x = 60, 392 mm from
+// the ToF centre) meets the plane (541.97 mm) beyond where the ToF's own ray does.
+
+TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForThePaperRig) {
+  // Colour camera 45 mm to -x: strip from 83 to 100 mm, 16 pixels by 113.
+  expect_occlusion_found(occlusion_by_a_box(paper_rig()), 1200);
+}
+
+TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheColourCameraOnTheOtherSide) {
+  json document = paper_rig();
+  document["depth_to_color"]["T_mm"] = {-45.0, 0.0, 0.0};
+  expect_occlusion_found(occlusion_by_a_box(document), 1200);
+}
+
+TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForARotatedDiagonalRig) {
+  json document = paper_rig();
+  document["depth_to_color"]["R"] = rotation(3, -4, 2);
+  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  expect_occlusion_found(occlusion_by_a_box(document), 1200);
+}
+
+TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheImage) {
+  // Colour camera 150 mm behind and 60 mm to -x: it sees the ToF's image from its
+  // epipole at pixel (517, 240), so the visiting order turns there; strip from 83 to
+  // 93 mm.
+  json document = paper_rig();
+  document["depth_to_color"]["T_mm"] = {60.0, 0.0, 150.0};
+  expect_occlusion_found(occlusion_by_a_box(document), 500);
+}
+
+// The 2x2 tile of each mosaic, row by row.
+std::string_view tile(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kBayerRggb8:
+      return "RGGB";
+    case PixelFormat::kBayerBggr8:
+      return "BGGR";
+    case PixelFormat::kBayerGrbg8:
+      return "GRBG";
+    default:
+      return "GBRG";
+  }
+}
+
+cv::Mat mosaic(const cv::Mat& bgr, PixelFormat format) {
+  cv::Mat out(bgr.size(), CV_8UC1);
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x < bgr.cols; ++x) {
+      const char site = tile(format)[static_cast<std::size_t>((y % 2) * 2 + x % 2)];
+      out.at<std::uint8_t>(y, x) = bgr.at<cv::Vec3b>(y, x)[site == 'B' ? 0 : site == 'G' ? 1 : 2];
+    }
+  }
+  return out;
+}
+
+constexpr PixelFormat kBayerFormats[] = {PixelFormat::kBayerRggb8, PixelFormat::kBayerBggr8,
+                                         PixelFormat::kBayerGrbg8, PixelFormat::kBayerGbrg8};
+
+TEST(ProjectiveRegistration, EachBayerPatternGivesBackAKnownColour) {
+  // Demosaicing a uniform mosaic gives its colour back exactly, and only with the right
+  // pattern: one swapped diagonal turns (30, 120, 210) into (210, 120, 30), one pixel of
+  // offset reads green as red and blue.
+  const cv::Mat uniform(1024, 1280, CV_8UC3, cv::Scalar(30, 120, 210));
+  const auto stage = make_registration(kPaperRig);
+  const ref::Rig rig = ref::rig_from(paper_rig());
+  const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
+  for (const PixelFormat format : kBayerFormats) {
+    const auto out = register_color(*stage, depth, mosaic(uniform, format), format);
+    const cv::Mat valid = out->status == RegisteredColor::kValid;
+    EXPECT_GT(cv::countNonZero(valid), 250000) << to_string(format);
+    cv::Mat as_expected;
+    cv::inRange(out->bgr, cv::Scalar(30, 120, 210), cv::Scalar(30, 120, 210), as_expected);
+    EXPECT_EQ(cv::countNonZero(valid & ~as_expected), 0) << to_string(format);
+  }
+}
+
+TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
+  cv::Mat smooth(1024, 1280, CV_8UC3);
+  for (int y = 0; y < smooth.rows; ++y) {
+    for (int x = 0; x < smooth.cols; ++x) {
+      smooth.at<cv::Vec3b>(y, x) = cv::Vec3b(
+          cv::saturate_cast<std::uint8_t>(128 + 100 * std::sin(x / 60.0) * std::cos(y / 80.0)),
+          cv::saturate_cast<std::uint8_t>(40 + 0.15 * x + 0.05 * y),
+          cv::saturate_cast<std::uint8_t>(200 - 0.12 * y));
+    }
+  }
+  const ref::Rig rig = ref::rig_from(paper_rig());
+  const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
+  // Bilinear demosaicing reproduces a linear ramp exactly; this image's curvature is at
+  // most 100 / 60^2 = 0.03 levels per pixel^2, far below a level over the 1-pixel
+  // neighbourhood, so what remains is the rounding of the image (0.5 level) and of the
+  // neighbour averages (0.5 level) and of bilinear sampling (0.5 level): 2 levels.
+  constexpr double kLevels = 2;
+  for (const std::string interpolation : {"nearest", "bilinear"}) {
+    const auto stage = make_registration(kPaperRig, interpolation);
+    const auto bgr = register_color(*stage, depth, smooth);
+    const cv::Mat valid = bgr->status == RegisteredColor::kValid;
+    ASSERT_GT(cv::countNonZero(valid), 250000);
+    for (const PixelFormat format : kBayerFormats) {
+      const auto bayer = register_color(*stage, depth, mosaic(smooth, format), format);
+      EXPECT_EQ(cv::countNonZero(bayer->status != bgr->status), 0);
+      EXPECT_LE(cv::norm(bayer->bgr, bgr->bgr, cv::NORM_INF, valid), kLevels)
+          << to_string(format) << ", " << interpolation;
+    }
+    cv::Mat rgb;
+    cv::cvtColor(smooth, rgb, cv::COLOR_BGR2RGB);
+    const auto from_rgb = register_color(*stage, depth, rgb, PixelFormat::kRgb8);
+    EXPECT_EQ(cv::norm(from_rgb->bgr, bgr->bgr, cv::NORM_INF), 0) << interpolation;
+
+    cv::Mat blue;
+    cv::extractChannel(smooth, blue, 0);
+    const auto from_mono = register_color(*stage, depth, blue, PixelFormat::kMono8);
+    cv::Mat registered_blue;
+    cv::extractChannel(bgr->bgr, registered_blue, 0);
+    cv::Mat expected_gray;
+    cv::merge(std::vector<cv::Mat>(3, registered_blue), expected_gray);
+    EXPECT_EQ(cv::norm(from_mono->bgr, expected_gray, cv::NORM_INF), 0) << interpolation;
+  }
+}
+
+TEST(ProjectiveRegistration, BilinearSamplingFollowsARampBetweenPixels) {
+  // B = 4 (u - 600) and G = 4 (v - 400) in a window: bilinear sampling reproduces the
+  // ramp at the projected position to within rounding (0.5 level) and 1/256 weights
+  // (4/512 level); nearest sampling would be up to 2 levels off.
+  cv::Mat ramp(1024, 1280, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int v = 400; v < 464; ++v) {
+    for (int u = 600; u < 664; ++u) {
+      ramp.at<cv::Vec3b>(v, u) = cv::Vec3b(static_cast<std::uint8_t>(4 * (u - 600)),
+                                           static_cast<std::uint8_t>(4 * (v - 400)), 0);
+    }
+  }
+  const json document = paper_rig();
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  const auto out = register_color(*make_registration(kPaperRig, "bilinear"), depth, ramp);
+  int compared = 0;
+  double worst = 0;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const auto p = ref::project(rig, rays[static_cast<std::size_t>(v * depth.cols + u)],
+                                  depth.at<float>(v, u));
+      if (p.u < 600.5L || p.u > 662.5L || p.v < 400.5L || p.v > 462.5L) continue;
+      ++compared;
+      const cv::Vec3b bgr = out->bgr.at<cv::Vec3b>(v, u);
+      worst = std::max({worst, static_cast<double>(std::abs(bgr[0] - 4 * (p.u - 600))),
+                        static_cast<double>(std::abs(bgr[1] - 4 * (p.v - 400)))});
+    }
+  }
+  EXPECT_GT(compared, 800);
+  EXPECT_LT(worst, 0.5 + 4.0 / 512 + 1e-3);
+}
+
+// The paper's eq. 3 reads W = K_d^-1 M K_c, which does not multiply (3x3, 3x4, 3x3); the
+// product that maps a depth pixel to a colour pixel is W = K_c [R | T] [K_d^-1 0; 0 1]
+// (3x4), and eqs. 4-5 use its first two rows, u = x w11 + y w12 + w13 + w14 / z, without
+// dividing by the third row. z is the depth image's value (eq. 1's result).
+struct Linearised {
+  Real w[3][4];
+
+  explicit Linearised(const ref::Rig& rig) {
+    const Real kd_inverse[3][3] = {{1 / rig.depth.fx, 0, -rig.depth.cx / rig.depth.fx},
+                                   {0, 1 / rig.depth.fy, -rig.depth.cy / rig.depth.fy},
+                                   {0, 0, 1}};
+    const Real kc[3][3] = {
+        {rig.color.fx, 0, rig.color.cx}, {0, rig.color.fy, rig.color.cy}, {0, 0, 1}};
+    const Real t[3] = {rig.t.x, rig.t.y, rig.t.z};
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        w[i][j] = 0;
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) w[i][j] += kc[i][a] * rig.r[a][b] * kd_inverse[b][j];
+        }
+      }
+      w[i][3] = kc[i][0] * t[0] + kc[i][1] * t[1] + kc[i][2] * t[2];
+    }
+  }
+
+  ref::Point2 map(int x, int y, Real z) const {
+    return {x * w[0][0] + y * w[0][1] + w[0][2] + w[0][3] / z,
+            x * w[1][0] + y * w[1][1] + w[1][2] + w[1][3] / z};
+  }
+};
+
+struct LinearisationError {
+  Real exact_vs_reference_px = 0;  // the stage's mapping
+  Real min_px = INFINITY;          // eqs. 4-5 against the reference
+  Real max_px = 0;
+  Real max_with_optical_centre_depth_px = 0;  // eqs. 4-5 with z + z_offset for z
+};
+
+LinearisationError linearisation_error(const json& document, const fs::path& file, Real z) {
+  const ref::Rig rig = ref::rig_from(document);
+  const DepthToColor map(load_calibration(file), file.string());
+  const Linearised paper(rig);
+  LinearisationError e;
+  const std::vector<float> depth_row(static_cast<std::size_t>(rig.depth.width),
+                                     static_cast<float>(z));
+  for (int y = 0; y < rig.depth.height; ++y) {
+    const MappedRow mapped(map, y, depth_row.data());
+    for (int x = 0; x < rig.depth.width; ++x) {
+      const auto exact = ref::project(rig, ref::depth_ray(rig, x, y), z);
+      if (exact.u < -0.5L || exact.u >= rig.color.width - 0.5L || exact.v < -0.5L ||
+          exact.v >= rig.color.height - 0.5L) {
+        continue;
+      }
+      e.exact_vs_reference_px = std::max(e.exact_vs_reference_px,
+                                         std::hypot(mapped.u[x] - exact.u, mapped.v[x] - exact.v));
+      const ref::Point2 linear = paper.map(x, y, z);
+      const Real error = std::hypot(linear.x - exact.u, linear.y - exact.v);
+      e.min_px = std::min(e.min_px, error);
+      e.max_px = std::max(e.max_px, error);
+      const ref::Point2 centred = paper.map(x, y, z + rig.z_offset);
+      e.max_with_optical_centre_depth_px = std::max(
+          e.max_with_optical_centre_depth_px, std::hypot(centred.x - exact.u, centred.y - exact.v));
+    }
+  }
+  return e;
+}
+
+TEST(ProjectiveRegistration, PapersLinearisedEqs4And5AgainstTheExactMappingForTheShippedRig) {
+  const json document = paper_rig();
+  const LinearisationError e = linearisation_error(document, kPaperRig, 518);
+  EXPECT_LT(e.exact_vs_reference_px, kMappingPx);
+  // With R = I and T_z = 0 the third row of W is (0, 0, 1, 0) and eqs. 4-5 are exact but
+  // for z: they divide by the depth from the mounting surface where the projection needs
+  // the optical-centre depth, which shifts every pixel along the baseline by
+  // fx_c T_x (1 / z - 1 / (z + z_offset)) = 1000 * 45 * (1/518 - 1/541.97) = 3.8416 px.
+  const Real shift = 1000.0L * 45.0L * (1 / 518.0L - 1 / (518.0L + 23.97L));
+  EXPECT_NEAR(static_cast<double>(e.max_px), static_cast<double>(shift), 1e-9);
+  EXPECT_NEAR(static_cast<double>(e.min_px), static_cast<double>(shift), 1e-9);
+  EXPECT_LT(e.max_with_optical_centre_depth_px, 1e-9L);
+  std::cout << "shipped rig at 518 mm: exact mapping vs reference "
+            << static_cast<double>(e.exact_vs_reference_px) << " px; eqs. 4-5 vs exact "
+            << static_cast<double>(e.max_px)
+            << " px (with z + z_offset: " << static_cast<double>(e.max_with_optical_centre_depth_px)
+            << " px)\n";
+}
+
+TEST(ProjectiveRegistration, PapersLinearisationFailsForARotatedRig) {
+  // The same rig turned 3 degrees about the ToF's y axis, a plausible mounting error:
+  // the third row of W is no longer (0, 0, 1, 0) and dropping its division costs pixels
+  // at the image sides even with the optical-centre depth.
+  json document = paper_rig();
+  document["depth_to_color"]["R"] = rotation(0, 3, 0);
+  const CalibrationFile file(document);
+  const LinearisationError e = linearisation_error(document, file.path(), 518);
+  EXPECT_LT(e.exact_vs_reference_px, kMappingPx);
+  EXPECT_GT(e.max_with_optical_centre_depth_px, 10.0L);
+  std::cout << "rig turned 3 degrees at 518 mm: eqs. 4-5 vs exact up to "
+            << static_cast<double>(e.max_px)
+            << " px (with z + z_offset: " << static_cast<double>(e.max_with_optical_centre_depth_px)
+            << " px)\n";
+}
+
+std::string process_error(Transform& stage, const cv::Mat& depth, const cv::Mat& color,
+                          PixelFormat format) {
+  try {
+    register_color(stage, depth, color, format);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "registered";
+}
+
+TEST(ProjectiveRegistration, InputsThatDoNotFitTheCalibrationAreRefused) {
+  const auto stage = make_registration(kPaperRig);
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(518));
+  const cv::Mat color(1024, 1280, CV_8UC3, cv::Scalar(0, 0, 0));
+  EXPECT_EQ(
+      process_error(*stage, cv::Mat(240, 320, CV_32FC1, cv::Scalar(518)), color,
+                    PixelFormat::kBgr8),
+      "depth image is 320x240 px but the calibration " + kPaperRig.string() + " is for 640x480 px");
+  EXPECT_EQ(process_error(*stage, depth, cv::Mat(480, 640, CV_8UC3), PixelFormat::kBgr8),
+            "colour image is 640x480 px but the calibration " + kPaperRig.string() +
+                " is for 1280x1024 px");
+  EXPECT_EQ(process_error(*stage, depth, cv::Mat(1024, 1280, CV_8UC1), PixelFormat::kBgr8),
+            "colour image (bgr8) has pixel type CV_8UC1; expected CV_8UC3");
+  EXPECT_EQ(process_error(*stage, depth, color, PixelFormat::kBayerRggb8),
+            "colour image (bayer_rggb8) has pixel type CV_8UC3; expected CV_8UC1");
+  EXPECT_EQ(process_error(*stage, cv::Mat(480, 640, CV_16UC1), color, PixelFormat::kBgr8),
+            "depth image has pixel type CV_16UC1; expected CV_32FC1 (mm)");
+}
+
+TEST(ProjectiveRegistration, ABadCalibrationIsRefusedAtConstructionWithTheFieldNamed) {
+  json document = paper_rig();
+  document["color_camera"]["fy"] = 0;
+  const CalibrationFile file(document);
+  try {
+    make_registration(file.path());
+    FAIL() << "constructed";
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              file.path().string() + ":/color_camera/fy: expected a number > 0, got 0");
+  }
+}
+
+TEST(ProjectiveRegistration, OutputBuffersAreReusedInSteadyState) {
+  const auto stage = make_registration(kPaperRig);
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(518));
+  const cv::Mat color = coordinate_image();
+  const std::uint8_t* bgr = nullptr;
+  const std::uint8_t* status = nullptr;
+  {
+    const auto out = register_color(*stage, depth, color);
+    bgr = out->bgr.data;
+    status = out->status.data;
+  }
+  const auto out = register_color(*stage, depth, color);
+  EXPECT_EQ(out->bgr.data, bgr);
+  EXPECT_EQ(out->status.data, status);
+}
+
+TEST(ProjectiveRegistration, DescriptorDeclaresTheContract) {
+  const StageDescriptor d = describe_projective();
+  EXPECT_EQ(d.type, "registration.projective");
+  ASSERT_EQ(d.inputs.size(), 2u);
+  EXPECT_EQ(d.inputs[0].name, "depth");
+  EXPECT_EQ(d.inputs[0].type, DepthImage::kTypeName);
+  EXPECT_EQ(d.inputs[1].name, "color");
+  EXPECT_EQ(d.inputs[1].type, ColorImage::kTypeName);
+  ASSERT_EQ(d.outputs.size(), 1u);
+  EXPECT_EQ(d.outputs[0].type, RegisteredColor::kTypeName);
+  ASSERT_NE(d.param("calibration"), nullptr);
+  EXPECT_TRUE(d.param("calibration")->required());
+  ASSERT_NE(d.param("occlusion_tolerance_mm"), nullptr);
+  EXPECT_EQ(d.param("occlusion_tolerance_mm")->default_value, 10.0);
+  ASSERT_NE(d.param("interpolation"), nullptr);
+  EXPECT_EQ(d.param("interpolation")->choices, (std::vector<std::string>{"nearest", "bilinear"}));
+  EXPECT_EQ(d.concurrency, Concurrency::kParallel);
+}
+
+}  // namespace
+}  // namespace tilth::registration

@@ -1,0 +1,70 @@
+// Makes a stage from its descriptor with the parameters the graph loader would give it,
+// and runs frames through it, for the tests and benchmarks of the measurement-chain
+// plugins (which link the stage objects directly instead of loading the plugin).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "tilth/error.h"
+#include "tilth/frame.h"
+#include "tilth/stage_descriptor.h"
+
+namespace tilth::testing {
+
+// Every declared parameter, its default unless `overrides` sets it. Throws tilth::Error
+// for an undeclared or ill-typed override, as the graph loader reports one.
+inline Params stage_params(const StageDescriptor& descriptor, const nlohmann::json& overrides) {
+  nlohmann::json values = nlohmann::json::object();
+  for (const auto& spec : descriptor.params) values[spec.name] = spec.default_value;
+  for (const auto& [name, value] : overrides.items()) {
+    const ParamSpec* spec = descriptor.param(name);
+    if (spec == nullptr) throw Error(descriptor.type + ": no parameter '" + name + "'");
+    if (const std::string expected = spec->check(value); !expected.empty()) {
+      throw Error(descriptor.type + ": parameter '" + name + "': expected " + expected + ", got " +
+                  value.dump());
+    }
+    values[name] = value;
+  }
+  return Params(std::move(values));
+}
+
+class TransformHarness {
+ public:
+  explicit TransformHarness(StageDescriptor descriptor,
+                            const nlohmann::json& overrides = nlohmann::json::object())
+      : descriptor_(std::move(descriptor)) {
+    StageContext context;
+    context.node = "under_test";
+    context.params = stage_params(descriptor_, overrides);
+    context.log = Logger(context.node);
+    stage_ = descriptor_.create(context);
+    transform_ = dynamic_cast<Transform*>(stage_.get());
+    if (transform_ == nullptr) throw Error(descriptor_.type + " is not a transform");
+  }
+
+  // One frame through the stage; an output it left unset is an empty packet. The packets
+  // own the messages: keep them (or copy the message) while reading an output.
+  std::vector<Packet> run(std::vector<std::shared_ptr<const Message>> inputs,
+                          std::uint64_t frame_id = 0) {
+    FrameInfo info;
+    info.sequence = frame_id;
+    info.frame_id = frame_id;
+    std::vector<Packet> in;
+    for (auto& message : inputs) in.emplace_back(info, std::move(message));
+    std::vector<Packet> out(descriptor_.outputs.size());
+    Frame frame(info, in, out);
+    transform_->process(frame);
+    return out;
+  }
+
+ private:
+  StageDescriptor descriptor_;
+  std::unique_ptr<Stage> stage_;
+  Transform* transform_ = nullptr;
+};
+
+}  // namespace tilth::testing

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Reproduces docs/accuracy.md: simulates the paper's static cases A-E (and the hard
+# cases) into image-folder recordings, runs graphs/paper.json on each, and tabulates
+# the distance error against ground truth like the paper's Table 2.
+# usage: bash tools/accuracy.sh [FRAMES_PER_CASE] > docs/accuracy.md   (after building)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+frames=${1:-20}
+tilth=build/bin/tilth
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cases="case_a case_b case_c case_d case_e wet_straw covered"
+for preset in $cases; do
+  "$tilth" run graphs/simulate.json --quiet --set scene.preset=$preset \
+    --set scene.frames=$frames --set recording.path="$work/$preset" >&2
+  "$tilth" run graphs/paper.json --quiet --set input.path="$work/$preset" \
+    --set output.path="$work/$preset.csv" >&2
+done
+/usr/bin/python3 tools/accuracy_report.py --frames "$frames" \
+  $(for preset in $cases; do echo "$preset=$work/$preset.csv"; done)

@@ -1,0 +1,70 @@
+"""Tabulates ground-distance errors from `sinks.csv` files with a truth column, like the
+paper's Table 2: per case the detected and actual distance and the error, with the
+error's mean, standard deviation and 95 % confidence interval. Prints Markdown."""
+import argparse
+import csv
+import math
+import statistics
+
+
+def read_case(path):
+    rows = list(csv.DictReader(open(path)))
+    valid = [r for r in rows if r["valid"] == "1"]
+    errors = [float(r["distance_mm"]) - float(r["truth_mm"]) for r in valid]
+    return rows, valid, errors
+
+
+def ci95(values):
+    if len(values) < 2:
+        return float("nan")
+    return 1.96 * statistics.stdev(values) / math.sqrt(len(values))
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--frames", type=int, required=True)
+    parser.add_argument("cases", nargs="+", help="NAME=CSV")
+    args = parser.parse_args()
+
+    print("# Accuracy on simulated recordings\n")
+    print("Produced by `bash tools/accuracy.sh %d > docs/accuracy.md`: each case is simulated"
+          % args.frames)
+    print("(`graphs/simulate.json`, %d frames, seed 1) into an image-folder recording and"
+          % args.frames)
+    print("measured by `graphs/paper.json` (projection, registration, colour-threshold")
+    print("segmentation, median estimator). Errors are detected minus actual distance.\n")
+    print("| case | frames | valid | detected (mm) | actual (mm) | error (mm) | std (mm) "
+          "| max abs (mm) | 95% CI of error (mm) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    paper_cases = []
+    for item in args.cases:
+        name, path = item.split("=", 1)
+        rows, valid, errors = read_case(path)
+        actual = float(rows[0]["truth_mm"]) if rows else float("nan")
+        if errors:
+            detected = statistics.mean(float(r["distance_mm"]) for r in valid)
+            error = statistics.mean(errors)
+            std = statistics.stdev(errors) if len(errors) > 1 else 0.0
+            half = ci95(errors)
+            worst = max(abs(e) for e in errors)
+            print("| %s | %d | %d | %.2f | %.2f | %+.2f | %.2f | %.2f | [%+.2f, %+.2f] |" % (
+                name, len(rows), len(valid), detected, actual, error, std, worst,
+                error - half, error + half))
+        else:
+            print("| %s | %d | 0 | - | %.2f | - | - | - | - |" % (name, len(rows), actual))
+        if name.startswith("case_"):
+            paper_cases.append((name, errors))
+    all_errors = [e for _, errors in paper_cases for e in errors]
+    if all_errors:
+        print("\nCases A-E together: mean error %+.2f mm, mean |error| %.2f mm, std %.2f mm, "
+              "max |error| %.2f mm, 95%% CI of the mean [%+.2f, %+.2f] mm over %d frames." % (
+                  statistics.mean(all_errors), statistics.mean(abs(e) for e in all_errors),
+                  statistics.stdev(all_errors), max(abs(e) for e in all_errors),
+                  statistics.mean(all_errors) - ci95(all_errors),
+                  statistics.mean(all_errors) + ci95(all_errors), len(all_errors)))
+    print("\nThe paper reports 517.2 mm against 518.0 mm for case A and errors up to 2.2 mm "
+          "over cases A-E. `covered` has no visible soil: every frame must be invalid.")
+
+
+if __name__ == "__main__":
+    main()
