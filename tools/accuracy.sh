@@ -2,11 +2,13 @@
 # Reproduces docs/accuracy.md: simulates the paper's static cases A-E (and the hard
 # cases) into image-folder recordings, runs graphs/paper.json on each, and tabulates
 # the distance error against ground truth like the paper's Table 2.
-# usage: bash tools/accuracy.sh [FRAMES_PER_CASE] > docs/accuracy.md   (after building)
+# usage: bash tools/accuracy.sh [FRAMES_PER_CASE [REPORT OPTIONS]] > docs/accuracy.md
+#   (after building; TILTH=path/to/tilth to use another build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-20}
-tilth=build/bin/tilth
+shift || true
+tilth=${TILTH:-build/bin/tilth}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cases="case_a case_b case_c case_d case_e wet_straw covered"
@@ -16,5 +18,5 @@ for preset in $cases; do
   "$tilth" run graphs/paper.json --quiet --set input.path="$work/$preset" \
     --set output.path="$work/$preset.csv" >&2
 done
-/usr/bin/python3 tools/accuracy_report.py --frames "$frames" \
+/usr/bin/python3 tools/accuracy_report.py --frames "$frames" "$@" \
   $(for preset in $cases; do echo "$preset=$work/$preset.csv"; done)

@@ -5,6 +5,7 @@ import argparse
 import csv
 import math
 import statistics
+import sys
 
 
 def read_case(path):
@@ -23,8 +24,12 @@ def ci95(values):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--frames", type=int, required=True)
+    parser.add_argument("--check-max-error-mm", type=float,
+                        help="exit 1 unless every frame of cases A-E is valid and within this "
+                             "error, and no frame of 'covered' is valid")
     parser.add_argument("cases", nargs="+", help="NAME=CSV")
     args = parser.parse_args()
+    problems = []
 
     print("# Accuracy on simulated recordings\n")
     print("Produced by `bash tools/accuracy.sh %d > docs/accuracy.md`: each case is simulated"
@@ -54,6 +59,14 @@ def main():
             print("| %s | %d | 0 | - | %.2f | - | - | - | - |" % (name, len(rows), actual))
         if name.startswith("case_"):
             paper_cases.append((name, errors))
+            if len(valid) != len(rows):
+                problems.append("%s: %d of %d frames invalid" % (name, len(rows) - len(valid), len(rows)))
+            worst_error = max((abs(e) for e in errors), default=0.0)
+            if args.check_max_error_mm is not None and worst_error > args.check_max_error_mm:
+                problems.append("%s: |error| %.2f mm > %.2f mm" % (name, worst_error,
+                                                                  args.check_max_error_mm))
+        if name == "covered" and valid:
+            problems.append("covered: %d frames reported valid" % len(valid))
     all_errors = [e for _, errors in paper_cases for e in errors]
     if all_errors:
         print("\nCases A-E together: mean error %+.2f mm, mean |error| %.2f mm, std %.2f mm, "
@@ -64,6 +77,25 @@ def main():
                   statistics.mean(all_errors) + ci95(all_errors), len(all_errors)))
     print("\nThe paper reports 517.2 mm against 518.0 mm for case A and errors up to 2.2 mm "
           "over cases A-E. `covered` has no visible soil: every frame must be invalid.")
+    print("""
+## What this shows, and what it does not
+
+- The chain is unbiased on these scenes: with stubble and up to 450 lying straws the
+  median of the soil depth in the central region lands within a fraction of a
+  millimetre of the truth, because the segmentation removes straw and stubble and the
+  dilation removes their mixed edge pixels before the statistic sees them.
+- The simulator's ToF model has range noise of 1 mm at 500 mm, dropouts and mixed
+  pixels, but no multipath, no intensity-dependent bias and no temperature drift; a
+  real blaze-101 adds those, and the tape measure the paper used has its own error. The
+  figures above are therefore the chain's own error, not a field accuracy.
+- `wet_straw` is the colour-threshold method's known failure: dark, wet straw is
+  classified as soil and its tops pull the distance short. Segmentation variants that
+  use depth address it (see docs/segmentation.md).
+- `covered` is reported invalid on every frame, never as a guess.""")
+    if args.check_max_error_mm is not None:
+        for problem in problems:
+            print("CHECK FAILED: " + problem, file=sys.stderr)
+        sys.exit(1 if problems else 0)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,11 @@
 // depth.projection against eq. 1 of the paper and spec/calibration.md, with the
 // expected values computed here in long double from the formulas, never by the stage.
 //
-// Tolerance kMm = 1e-3 mm throughout: the stage works in float32, whose spacing at
+// Tolerance kMm = 1e-3 mm unless noted: the stage works in float32, whose spacing at
 // 512-1024 mm is 6.1e-5 mm, and rounds about four times per pixel (scale, offset,
 // factor, z offset), so its error stays below 1e-3 mm. That is 1/20 of one gray step
-// (0.0229 mm) and 1/300 of what a one-pixel index error (1-based pixels) moves a corner
-// pixel's depth (0.33 mm at 518 mm), so the tests see either.
+// (0.0229 mm) and 1/700 of what 1-based pixel indices would move a corner pixel's depth
+// (0.72 mm at 518 mm), so the tests see either.
 #include <cmath>
 #include <filesystem>
 #include <fstream>

@@ -153,6 +153,11 @@ cv::Mat plane_depth(const ref::Rig& rig, const std::vector<ref::Vec3>& rays, Rea
 
 bool near_half(Real x) { return std::abs(x - std::floor(x) - 0.5L) < kMappingPx; }
 
+bool near_edge(const ref::ColorPixel& p, const ref::Rig& rig) {
+  return std::min({std::abs(p.u + 0.5L), std::abs(p.u - (rig.color.width - 0.5L)),
+                   std::abs(p.v + 0.5L), std::abs(p.v - (rig.color.height - 0.5L))}) < kMappingPx;
+}
+
 struct Agreement {
   int in_image = 0;  // pixels the reference sees inside the colour image
   int compared = 0;  // of those, sampled pixels compared (not at a rounding tie)
@@ -202,9 +207,7 @@ Agreement compare(const json& document, const fs::path& file, const cv::Mat& dep
       const ref::ColorPixel expected = ref::project(rig, rays[static_cast<std::size_t>(pixel)], z);
       const bool inside = expected.depth > 0 && expected.u >= -0.5L && expected.u < right &&
                           expected.v >= -0.5L && expected.v < bottom;
-      const bool at_edge =
-          std::min({std::abs(expected.u + 0.5L), std::abs(expected.u - right),
-                    std::abs(expected.v + 0.5L), std::abs(expected.v - bottom)}) < kMappingPx;
+      const bool at_edge = near_edge(expected, rig);
       if (inside) {
         ++a.in_image;
         a.max_mapping_error_px = std::max(
@@ -318,7 +321,7 @@ TEST(ProjectiveRegistration, PointsBeyondTheDistortionsFoldAreOutsideNotFoldedIn
         ++beyond_fold;
         folded_into_image += lands_inside ? 1 : 0;
         beyond_fold_not_outside += status == RegisteredColor::kOutsideColor ? 0 : 1;
-      } else if (p.radius2 < fold_radius2 * 0.99L && !near_half(p.u) && !near_half(p.v)) {
+      } else if (p.radius2 < fold_radius2 * 0.99L && !near_edge(p, rig)) {
         ++within_checked;
         const auto expected =
             lands_inside ? RegisteredColor::kValid : RegisteredColor::kOutsideColor;
@@ -375,7 +378,7 @@ BoxOcclusion occlusion_by_a_box(const json& document) {
   // Clearly occluded: hidden by more than the tolerance (10 mm) + 15 mm, as are all
   // neighbours within 2 pixels. Clearly visible: no neighbour within 3 pixels hidden and
   // no depth step over the tolerance there. The bands between are where a z-buffer cell
-  // (2 colour pixels, one ToF pixel) straddles the occlusion's edge.
+  // (3 colour pixels, 1.5 ToF pixels for these rigs) straddles the occlusion's edge.
   BoxOcclusion result;
   for (int v = 3; v < depth.rows - 3; ++v) {
     for (int u = 3; u < depth.cols - 3; ++u) {
@@ -432,6 +435,8 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheColourCameraOnTheOt
 }
 
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForARotatedDiagonalRig) {
+  // The box top's samples reach the colour image as a turned lattice; z-buffer cells one
+  // depth pixel wide left holes in it here, and the plane behind them got the box's colour.
   json document = paper_rig();
   document["depth_to_color"]["R"] = rotation(3, -4, 2);
   document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
@@ -439,9 +444,9 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForARotatedDiagonalRig) {
 }
 
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheImage) {
-  // Colour camera 150 mm behind and 60 mm to -x: it sees the ToF's image from its
-  // epipole at pixel (517, 240), so the visiting order turns there; strip from 83 to
-  // 93 mm.
+  // Colour camera 150 mm behind and 60 mm to -x: its epipole lies inside the ToF image
+  // (pixel 517, 240), so the parallax runs radially from there rather than along one
+  // direction; strip from 83 to 93 mm.
   json document = paper_rig();
   document["depth_to_color"]["T_mm"] = {60.0, 0.0, 150.0};
   expect_occlusion_found(occlusion_by_a_box(document), 500);
