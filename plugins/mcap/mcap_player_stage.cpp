@@ -1,0 +1,300 @@
+// mcap.player: replays an MCAP recording that mcap.writer made, as fast as possible or
+// paced by the depth timestamps, optionally only a time window of it.
+//
+//   FILE.mcap ──> mcap.player ──> raw, color, truth
+//
+// Frames are rebuilt from the consecutive messages of a chunk that share a sequence
+// number (the frame id).
+// With a summary, the chunks outside [start_s, end_s] are skipped using the ChunkIndex
+// records without being read; without one (a file cut off mid-write) the chunks found
+// by scanning the file from the start are played and a warning says how much was
+// recovered.
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <limits>
+#include <mutex>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "mcap_reader.h"
+#include "raw_image.h"
+#include "recording_layout.h"
+#include "tilth/calibration.h"
+#include "tilth/error.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_truth.h"
+#include "tilth/messages/raw_tof_frame.h"
+#include "tilth/plugin.h"
+
+namespace tilth::mcap {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t kRawPort = 0;
+constexpr std::size_t kColorPort = 1;
+constexpr std::size_t kTruthPort = 2;
+
+// The messages of one frame, still encoded.
+struct RecordedFrame {
+  std::uint32_t sequence = 0;
+  std::optional<Message> raw;
+  std::optional<Message> color;
+  std::optional<Message> truth;
+  std::optional<Message> mask;
+};
+
+std::uint64_t seconds_to_ns(double seconds) {
+  return static_cast<std::uint64_t>(seconds * 1e9 + 0.5);
+}
+
+RigCalibration read_calibration(McapReader& reader) {
+  const std::optional<Attachment> attachment = reader.find_attachment(kCalibrationAttachment);
+  if (!attachment) {
+    throw Error(reader.file().string() + ": has no attachment named " +
+                std::string(kCalibrationAttachment) + " (the rig calibration mcap.writer stores)");
+  }
+  const std::string origin = reader.file().string() + ":" + attachment->name;
+  const nlohmann::json document = nlohmann::json::parse(attachment->data, nullptr, false);
+  if (document.is_discarded()) throw Error(origin + ": not valid JSON");
+  return parse_calibration(document, origin);
+}
+
+class McapPlayer final : public Source {
+ public:
+  explicit McapPlayer(const StageContext& context)
+      : reader_(context.params.path("path")),
+        calibration_(read_calibration(reader_)),
+        rate_(context.params.number("rate")),
+        log_(context.log) {
+    for (const auto& [id, channel] : reader_.channels()) {
+      if (channel.topic == kRawTopic) raw_channel_ = id;
+      if (channel.topic == kColorTopic) color_channel_ = id;
+      if (channel.topic == kTruthTopic) truth_channel_ = id;
+      if (channel.topic == kMaskTopic) mask_channel_ = id;
+    }
+    if (!raw_channel_ || !color_channel_) {
+      throw Error(reader_.file().string() + ": expected channels " + std::string(kRawTopic) +
+                  " and " + std::string(kColorTopic) + " (an mcap.writer recording)");
+    }
+    if (const auto& recovery = reader_.recovery()) {
+      log_.warning(reader_.file().string() +
+                   ": no summary (the recording was cut off while "
+                   "written?); recovered " +
+                   std::to_string(reader_.chunks().size()) + " complete chunks, " +
+                   std::to_string(recovery->readable_bytes) + " of " +
+                   std::to_string(reader_.file_size()) + " bytes; " + recovery->stop_reason);
+    }
+    select_chunks(context.params.number("start_s"), context.params.number("end_s"));
+  }
+
+  bool produce(Frame& frame) override {
+    for (;;) {
+      while (ready_.empty()) {
+        if (next_chunk_ == chunks_.size()) return false;
+        read_chunk(chunks_[next_chunk_++]);
+      }
+      RecordedFrame recorded = std::move(ready_.front());
+      ready_.pop_front();
+      if (!recorded.raw || !recorded.color) {
+        log_.warning(reader_.file().string() + ": frame " + std::to_string(recorded.sequence) +
+                     " lacks its " + std::string(recorded.raw ? kColorTopic : kRawTopic) +
+                     " message; skipped");
+        continue;
+      }
+      const std::uint64_t time = recorded.raw->log_time;
+      if (time < start_ns_ || time > end_ns_) continue;
+      if (!wait_until_due(time)) return false;
+      emit(frame, recorded);
+      return true;
+    }
+  }
+
+  void interrupt() override {
+    {
+      std::lock_guard lock(mutex_);
+      interrupted_ = true;
+    }
+    wake_.notify_all();
+  }
+
+ private:
+  // The window as absolute log times, from the recording's first message; the chunks
+  // that overlap it.
+  void select_chunks(double start_s, double end_s) {
+    std::uint64_t first = std::numeric_limits<std::uint64_t>::max();
+    if (reader_.statistics() && reader_.statistics()->message_count > 0) {
+      first = reader_.statistics()->message_start_time;
+    } else {
+      for (const ChunkIndex& chunk : reader_.chunks()) {
+        first = std::min(first, chunk.message_start_time);
+      }
+    }
+    start_ns_ = first + seconds_to_ns(start_s);
+    end_ns_ = end_s > 0 ? first + seconds_to_ns(end_s) : std::numeric_limits<std::uint64_t>::max();
+    if (end_s > 0 && end_s < start_s) {
+      throw Error("end_s " + std::to_string(end_s) + ": expected 0 (the end) or >= start_s " +
+                  std::to_string(start_s));
+    }
+    for (const ChunkIndex& chunk : reader_.chunks()) {
+      if (chunk.message_end_time < start_ns_ || chunk.message_start_time > end_ns_) continue;
+      chunks_.push_back(chunk);
+    }
+    std::stable_sort(chunks_.begin(), chunks_.end(), [](const ChunkIndex& a, const ChunkIndex& b) {
+      return a.message_start_time < b.message_start_time;
+    });
+  }
+
+  // Groups the chunk's messages into frames by sequence number. mcap.writer never splits
+  // a frame across chunks, so a frame ends with its chunk at the latest.
+  void read_chunk(const ChunkIndex& chunk) {
+    for (Message& message : reader_.read_chunk(chunk)) {
+      if (ready_.empty() || ready_.back().sequence != message.sequence) {
+        ready_.emplace_back();
+        ready_.back().sequence = message.sequence;
+      }
+      RecordedFrame& frame = ready_.back();
+      const std::uint16_t channel = message.channel_id;
+      if (channel == raw_channel_) {
+        frame.raw = std::move(message);
+      } else if (channel == color_channel_) {
+        frame.color = std::move(message);
+      } else if (channel == truth_channel_) {
+        frame.truth = std::move(message);
+      } else if (channel == mask_channel_) {
+        frame.mask = std::move(message);
+      }
+    }
+  }
+
+  // Paces by the depth log times relative to the first frame played. False when
+  // interrupted.
+  bool wait_until_due(std::uint64_t time) {
+    std::unique_lock lock(mutex_);
+    if (rate_ > 0) {
+      if (!first_played_) {
+        first_played_ = time;
+        play_start_ = Clock::now();
+      }
+      const double recorded_ns = static_cast<double>(time - *first_played_);
+      const auto due =
+          play_start_ + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double, std::nano>(recorded_ns / rate_));
+      wake_.wait_until(lock, due, [this] { return interrupted_; });
+    }
+    return !interrupted_;
+  }
+
+  std::string where(const Message& message) const {
+    const auto& topic = reader_.channels().at(message.channel_id).topic;
+    return reader_.file().string() + ": " + topic + " frame " + std::to_string(message.sequence);
+  }
+
+  // The image of a message, in the calibration's size; `encoding` "" accepts any.
+  RawImage image(const Message& message, cv::Size size, std::string_view encoding) const {
+    RawImage decoded = decode_raw_image(message.data, where(message));
+    if (!encoding.empty() && decoded.encoding != encoding) {
+      throw Error(where(message) + ": expected encoding " + std::string(encoding) + ", got " +
+                  decoded.encoding);
+    }
+    if (decoded.pixels.size() != size) {
+      throw Error(where(message) + ": expected " + std::to_string(size.width) + "x" +
+                  std::to_string(size.height) + " (the calibration's size), got " +
+                  std::to_string(decoded.pixels.cols) + "x" + std::to_string(decoded.pixels.rows));
+    }
+    return decoded;
+  }
+
+  void emit(Frame& frame, const RecordedFrame& recorded) const {
+    const cv::Size depth_size(calibration_.depth.width, calibration_.depth.height);
+    const cv::Size color_size(calibration_.color.width, calibration_.color.height);
+
+    RawTofFrame raw;
+    raw.gray = image(*recorded.raw, depth_size, "mono16").pixels;
+    raw.device_timestamp_ns = static_cast<std::int64_t>(recorded.raw->log_time);
+
+    ColorImage color;
+    RawImage color_image = image(*recorded.color, color_size, "");
+    const std::optional<PixelFormat> format = parse_pixel_format(color_image.encoding);
+    if (!format) {
+      throw Error(where(*recorded.color) + ": encoding " + color_image.encoding +
+                  " is not a Tilth pixel format");
+    }
+    color.format = *format;
+    color.pixels = std::move(color_image.pixels);
+    color.device_timestamp_ns = static_cast<std::int64_t>(recorded.color->log_time);
+
+    GroundTruth truth;
+    if (recorded.truth) {
+      truth.distance_mm =
+          decode_ground_truth(recorded.truth->data, where(*recorded.truth)).distance_mm;
+    }
+    if (recorded.mask) truth.residue_mask = image(*recorded.mask, depth_size, "mono8").pixels;
+
+    const auto host_now = std::chrono::system_clock::now().time_since_epoch();
+    frame.set_capture(recorded.sequence, raw.device_timestamp_ns,
+                      std::chrono::duration_cast<std::chrono::nanoseconds>(host_now).count());
+    frame.emit(kRawPort, std::move(raw));
+    frame.emit(kColorPort, std::move(color));
+    frame.emit(kTruthPort, std::move(truth));
+  }
+
+  McapReader reader_;
+  const RigCalibration calibration_;
+  const double rate_;
+  const Logger log_;
+  std::optional<std::uint16_t> raw_channel_;
+  std::optional<std::uint16_t> color_channel_;
+  std::optional<std::uint16_t> truth_channel_;
+  std::optional<std::uint16_t> mask_channel_;
+
+  std::uint64_t start_ns_ = 0;
+  std::uint64_t end_ns_ = 0;
+  std::vector<ChunkIndex> chunks_;  // the ones to play, in time order
+  std::size_t next_chunk_ = 0;
+  std::deque<RecordedFrame> ready_;  // decoded from the chunks read so far, not yet played
+
+  std::optional<std::uint64_t> first_played_;
+  Clock::time_point play_start_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool interrupted_ = false;
+};
+
+StageDescriptor describe() {
+  StageDescriptor d;
+  d.type = "mcap.player";
+  d.summary = "replays an MCAP recording made by mcap.writer, also one cut off mid-write";
+  d.outputs = {
+      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray; device time = its log time"),
+      PortSpec::of<ColorImage>("color", "the colour image as recorded; device time = its log time"),
+      PortSpec::of<GroundTruth>("truth", "the recorded distance and mask; empty when none"),
+  };
+  d.params = {
+      ParamSpec::path("path", std::nullopt).describe("the MCAP file"),
+      ParamSpec::number("rate", 0.0)
+          .range(0, std::nullopt)
+          .describe("playback speed: 0 = as fast as possible, 1 = as recorded (paced by the depth "
+                    "timestamps), 2 = twice as fast"),
+      ParamSpec::number("start_s", 0.0)
+          .range(0, std::nullopt)
+          .in_unit("s")
+          .describe("first frame to play, from the recording's first message"),
+      ParamSpec::number("end_s", 0.0)
+          .range(0, std::nullopt)
+          .in_unit("s")
+          .describe("last frame to play, from the recording's first message; 0 = the end"),
+  };
+  d.concurrency = Concurrency::kSerial;
+  d.create = factory<McapPlayer>();
+  return d;
+}
+
+}  // namespace
+
+TILTH_STAGE(describe());
+
+}  // namespace tilth::mcap

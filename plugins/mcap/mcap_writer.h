@@ -1,0 +1,111 @@
+// Writes an MCAP file: Header, then schemas, channels, attachments and metadata as they
+// are added, messages in compressed chunks each followed by its MessageIndex records,
+// and on finish() DataEnd, the summary section, SummaryOffset records and the Footer.
+// Closed chunks are compressed on background threads (compressing a 30 frame/s stream
+// of base64 images takes more than one core) and written, in order, as they complete;
+// each is flushed to the file when written, so a process killed mid-write leaves a file
+// that is readable up to its last written chunk.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mcap_format.h"
+
+namespace tilth::mcap {
+
+struct WriterOptions {
+  std::string compression = std::string(kZstd);  // "zstd", "lz4" or "" (none)
+  // A chunk is closed by close_chunk_if_full() once it holds this many bytes.
+  std::uint64_t chunk_size = 4 * 1024 * 1024;
+  // Closed chunks being compressed at once; close_chunk() waits for the oldest beyond.
+  std::size_t chunks_in_flight = 2;
+  std::string profile;  // the Header's profile; "" = none of the well-known ones
+  std::string library = "tilth";
+};
+
+class McapWriter {
+ public:
+  // Creates (or replaces) the file and writes the magic and the Header.
+  McapWriter(std::filesystem::path file, WriterOptions options);
+  // Waits for the background compressions; a writer not finished leaves the file as a
+  // process killed after the last written chunk would.
+  ~McapWriter();
+  McapWriter(const McapWriter&) = delete;
+  McapWriter& operator=(const McapWriter&) = delete;
+
+  // Each returns the id the file uses.
+  std::uint16_t add_schema(const std::string& name, const std::string& encoding,
+                           const std::string& data);
+  std::uint16_t add_channel(std::uint16_t schema_id, const std::string& topic,
+                            const std::string& message_encoding,
+                            const std::map<std::string, std::string>& metadata = {});
+  void add_attachment(const Attachment& attachment);
+  void add_metadata(const Metadata& metadata);
+
+  // Into the open chunk.
+  void write(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time,
+             std::uint64_t publish_time, std::string_view data);
+  // Closes the open chunk when it has reached chunk_size: call between messages that
+  // belong in one chunk (a frame's images).
+  void close_chunk_if_full();
+  // Hands the open chunk, if it has messages, to a background compression; writes the
+  // chunks whose compression is done, oldest first, while more than chunks_in_flight
+  // are pending.
+  void close_chunk();
+  // Closes the open chunk and writes every pending one with its MessageIndex records.
+  void flush();
+  // Closes the open chunk and writes DataEnd, the summary and the Footer. The writer
+  // accepts nothing after it.
+  void finish();
+
+  std::uint64_t bytes_written() const { return offset_; }
+
+ private:
+  // Writes to the file, counting the offset and the data section's CRC.
+  void put(std::string_view bytes);
+  void check_open(std::string_view what) const;
+  struct ClosedChunk;
+  void write_chunk(ClosedChunk& chunk);
+
+  const std::filesystem::path file_;
+  const WriterOptions options_;
+  std::ofstream out_;
+  std::uint64_t offset_ = 0;
+  std::uint32_t data_crc_ = 0;
+  bool finished_ = false;
+
+  std::vector<Schema> schemas_;
+  std::vector<Channel> channels_;
+  std::vector<ChunkIndex> chunk_indexes_;
+  std::vector<AttachmentIndex> attachment_indexes_;
+  std::vector<MetadataIndex> metadata_indexes_;
+  Statistics statistics_;
+
+  // The open chunk.
+  std::string chunk_records_;
+  std::uint64_t chunk_start_time_ = 0;
+  std::uint64_t chunk_end_time_ = 0;
+  // Per channel: (log_time, offset in chunk_records_) of each message.
+  using MessageOffsets =
+      std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>>;
+  MessageOffsets chunk_index_;
+
+  // A chunk closed and being compressed.
+  struct ClosedChunk {
+    std::uint64_t start_time = 0;
+    std::uint64_t end_time = 0;
+    std::uint64_t uncompressed_size = 0;
+    MessageOffsets index;
+    std::future<std::pair<std::string, std::uint32_t>> compressed;  // data, uncompressed CRC
+  };
+  std::deque<ClosedChunk> closed_;
+};
+
+}  // namespace tilth::mcap

@@ -1,0 +1,191 @@
+// mcap.writer: records raw ToF frames, colour images and ground truth as an MCAP file
+// that mcap.player replays and Foxglove opens as it is.
+//
+//   raw ──┐
+//   color ├─> mcap.writer ──> FILE.mcap: /tof/raw, /color/image, /truth, /truth/mask
+//   truth ┘   (optional)
+//
+// Invariant: a frame's messages are never split across chunks (a chunk is closed only
+// between frames), so a file cut off mid-write loses whole frames, never half of one.
+#include <chrono>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "mcap_writer.h"
+#include "raw_image.h"
+#include "recording_layout.h"
+#include "tilth/calibration.h"
+#include "tilth/error.h"
+#include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_truth.h"
+#include "tilth/messages/raw_tof_frame.h"
+#include "tilth/plugin.h"
+
+namespace tilth::mcap {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kRawPort = 0;
+constexpr std::size_t kColorPort = 1;
+constexpr std::size_t kTruthPort = 2;
+
+std::string read_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw Error(file.string() + ": cannot read");
+  return text.str();
+}
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+void check_image(std::string_view port, const cv::Mat& image, int type, cv::Size size) {
+  if (image.type() != type || image.size() != size) {
+    throw Error(std::string(port) + ": expected a " + std::to_string(size.width) + "x" +
+                std::to_string(size.height) + " image of OpenCV type " + std::to_string(type) +
+                " (the calibration's size), got " + std::to_string(image.cols) + "x" +
+                std::to_string(image.rows) + " of type " + std::to_string(image.type()));
+  }
+}
+
+std::uint64_t device_time(std::string_view port, std::int64_t timestamp_ns) {
+  if (timestamp_ns < 0) {
+    throw Error(std::string(port) + ": device timestamp " + std::to_string(timestamp_ns) +
+                " ns; expected >= 0 (MCAP times are unsigned)");
+  }
+  return static_cast<std::uint64_t>(timestamp_ns);
+}
+
+WriterOptions writer_options(const Params& params) {
+  WriterOptions options;
+  const std::string compression = params.string("compression");
+  options.compression = compression == "none" ? "" : compression;
+  options.chunk_size = static_cast<std::uint64_t>(params.integer("chunk_size"));
+  return options;
+}
+
+class McapWriterStage final : public Sink {
+ public:
+  explicit McapWriterStage(const StageContext& context)
+      : calibration_text_(read_file(context.params.path("calibration"))),
+        calibration_(parse_calibration(nlohmann::json::parse(calibration_text_, nullptr, false),
+                                       context.params.path("calibration").string())),
+        depth_size_(calibration_.depth.width, calibration_.depth.height),
+        color_size_(calibration_.color.width, calibration_.color.height),
+        writer_(context.params.path("path"), writer_options(context.params)) {
+    const std::uint64_t created = now_ns();
+    writer_.add_attachment({created, created, std::string(kCalibrationAttachment),
+                            "application/json", calibration_text_});
+    writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", calibration_text_}}});
+    const fs::path graph = context.params.string("graph_file");
+    std::map<std::string, std::string> recording{{"node", context.node}};
+    if (!graph.empty()) {
+      writer_.add_attachment(
+          {created, created, graph.filename().string(), "application/json", read_file(graph)});
+      recording["graph_file"] = graph.filename().string();
+    }
+    writer_.add_metadata({std::string(kRecordingMetadata), recording});
+
+    const std::string json_schema(kJsonSchemaEncoding);
+    const std::string json(kJsonEncoding);
+    const std::uint16_t image =
+        writer_.add_schema(std::string(kRawImageSchemaName), json_schema, raw_image_schema());
+    const std::uint16_t truth =
+        writer_.add_schema(std::string(kGroundTruthSchemaName), json_schema, ground_truth_schema());
+    raw_channel_ = writer_.add_channel(image, std::string(kRawTopic), json);
+    color_channel_ = writer_.add_channel(image, std::string(kColorTopic), json);
+    truth_channel_ = writer_.add_channel(truth, std::string(kTruthTopic), json);
+    mask_channel_ = writer_.add_channel(image, std::string(kMaskTopic), json);
+  }
+
+  void consume(const Frame& frame) override {
+    const auto& raw = frame.input<RawTofFrame>(kRawPort);
+    const auto& color = frame.input<ColorImage>(kColorPort);
+    const Packet& truth_packet = frame.input(kTruthPort);
+    const GroundTruth* truth = truth_packet.empty() ? nullptr : &truth_packet.get<GroundTruth>();
+
+    const std::uint64_t frame_id = frame.info().frame_id;
+    if (frame_id > std::numeric_limits<std::uint32_t>::max()) {
+      throw Error("frame id " + std::to_string(frame_id) +
+                  " does not fit the 32-bit MCAP sequence number");
+    }
+    const auto sequence = static_cast<std::uint32_t>(frame_id);
+    check_image("raw", raw.gray, CV_16UC1, depth_size_);
+    check_image("color", color.pixels, CV_8UC(channels(color.format)), color_size_);
+    const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
+    if (has_mask) check_image("truth mask", truth->residue_mask, CV_8UC1, depth_size_);
+    const std::uint64_t raw_time = device_time("raw", raw.device_timestamp_ns);
+    const std::uint64_t color_time = device_time("color", color.device_timestamp_ns);
+
+    writer_.write(raw_channel_, sequence, raw_time, raw_time,
+                  encode_raw_image(raw.gray, "mono16", raw.device_timestamp_ns, kTofFrameId));
+    writer_.write(color_channel_, sequence, color_time, color_time,
+                  encode_raw_image(color.pixels, to_string(color.format), color.device_timestamp_ns,
+                                   kColorFrameId));
+    if (truth != nullptr) {
+      writer_.write(truth_channel_, sequence, raw_time, raw_time,
+                    encode_ground_truth(truth->distance_mm, has_mask, raw.device_timestamp_ns));
+      if (has_mask) {
+        writer_.write(
+            mask_channel_, sequence, raw_time, raw_time,
+            encode_raw_image(truth->residue_mask, "mono8", raw.device_timestamp_ns, kTofFrameId));
+      }
+    }
+    writer_.close_chunk_if_full();
+  }
+
+  void finish() override { writer_.finish(); }
+
+ private:
+  const std::string calibration_text_;
+  const RigCalibration calibration_;
+  const cv::Size depth_size_;
+  const cv::Size color_size_;
+  McapWriter writer_;
+  std::uint16_t raw_channel_ = 0;
+  std::uint16_t color_channel_ = 0;
+  std::uint16_t truth_channel_ = 0;
+  std::uint16_t mask_channel_ = 0;
+};
+
+StageDescriptor describe() {
+  StageDescriptor d;
+  d.type = "mcap.writer";
+  d.summary = "records raw ToF, colour and ground truth as an MCAP file (Foxglove RawImage)";
+  d.inputs = {
+      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
+      PortSpec::of<ColorImage>("color", "bgr8, rgb8, mono8 or a Bayer mosaic"),
+      PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
+  };
+  d.params = {
+      ParamSpec::path("path", std::nullopt)
+          .describe("the MCAP file to create (replaced if it exists)"),
+      ParamSpec::choice("compression", {"zstd", "lz4", "none"}, "zstd")
+          .describe("chunk compression"),
+      ParamSpec::integer("chunk_size", 4 * 1024 * 1024)
+          .range(1, std::nullopt)
+          .in_unit("bytes")
+          .describe("a chunk is closed after the frame that makes it this large"),
+      ParamSpec::path("calibration", std::nullopt)
+          .describe("the rig's calibration file; stored as the attachment rig.calib.json and as "
+                    "metadata"),
+      ParamSpec::string("graph_file", "")
+          .describe("a graph file to store as an attachment (relative to the working directory); "
+                    "\"\" = none"),
+  };
+  d.concurrency = Concurrency::kSerial;
+  d.create = factory<McapWriterStage>();
+  return d;
+}
+
+}  // namespace
+
+TILTH_STAGE(describe());
+
+}  // namespace tilth::mcap

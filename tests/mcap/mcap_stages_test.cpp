@@ -1,0 +1,191 @@
+// mcap.writer -> mcap.player through the real runtime: every pixel, timestamp and truth
+// survives in each pixel format and compression; what the file holds (channels,
+// schemas, attachments, metadata, summary); seeking by time; the writer's throughput at
+// the rig's full image sizes.
+#include <sys/resource.h>
+
+#include <chrono>
+#include <fstream>
+
+#include "mcap_fixture.h"
+#include "mcap_reader.h"
+#include "mcap_recording.h"
+#include "raw_image.h"
+
+namespace tilth::testing {
+namespace {
+
+using nlohmann::json;
+
+class McapStagesTest : public McapTest {};
+
+TEST_F(McapStagesTest, RoundTripKeepsEveryPixelTimestampAndTruth) {
+  frames_ = make_frames(5, small_calibration(), 3);
+  const fs::path file = dir_.path() / "bgr.mcap";
+  const RunResult recorded = record(file, PixelFormat::kBgr8);
+  ASSERT_FALSE(recorded.failed) << recorded.failure;
+  const RunResult played = play(file);
+  ASSERT_FALSE(played.failed) << played.failure;
+  expect_played(PixelFormat::kBgr8, 0, frames_.size());
+  EXPECT_TRUE(warnings().empty());
+}
+
+TEST_F(McapStagesTest, RoundTripOfBayerAtFullSizeInEveryCompression) {
+  const json calibration = json::parse(read_text(shipped_calibration_file()));
+  frames_ = make_frames(2, calibration, 1);
+  for (const std::string compression : {"zstd", "lz4", "none"}) {
+    SCOPED_TRACE(compression);
+    const fs::path file = dir_.path() / (compression + ".mcap");
+    const RunResult recorded =
+        record(file, PixelFormat::kBayerGrbg8,
+               {{"compression", compression}, {"calibration", shipped_calibration_file()}});
+    ASSERT_FALSE(recorded.failed) << recorded.failure;
+    const RunResult played = play(file);
+    ASSERT_FALSE(played.failed) << played.failure;
+    expect_played(PixelFormat::kBayerGrbg8, 0, frames_.size());
+    mcap::McapReader reader(file);
+    ASSERT_FALSE(reader.chunks().empty());
+    EXPECT_EQ(reader.chunks().front().compression, compression == "none" ? "" : compression);
+  }
+}
+
+TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
+  frames_ = make_frames(4, small_calibration(), 3);
+  const fs::path graph_file = dir_.write("recorded.graph.json", R"({"nodes": {}})");
+  const fs::path file = dir_.path() / "contents.mcap";
+  const RunResult recorded =
+      record(file, PixelFormat::kBgr8, {{"graph_file", graph_file}, {"chunk_size", 1}});
+  ASSERT_FALSE(recorded.failed) << recorded.failure;
+
+  mcap::McapReader reader(file);
+  EXPECT_FALSE(reader.recovery());
+  ASSERT_TRUE(reader.statistics());
+  std::map<std::string, std::uint64_t> counts;
+  for (const auto& [id, channel] : reader.channels()) {
+    EXPECT_EQ(channel.message_encoding, "json");
+    const mcap::Schema& schema = reader.schemas().at(channel.schema_id);
+    EXPECT_EQ(schema.encoding, "jsonschema");
+    EXPECT_EQ(schema.name, channel.topic == "/truth" ? "tilth.GroundTruth" : "foxglove.RawImage");
+    counts[channel.topic] = reader.statistics()->channel_message_counts.at(id);
+  }
+  const std::map<std::string, std::uint64_t> expected_counts{
+      {"/tof/raw", 4}, {"/color/image", 4}, {"/truth", 4}, {"/truth/mask", 2}};
+  EXPECT_EQ(counts, expected_counts);
+  EXPECT_EQ(reader.chunks().size(), 4u);  // chunk_size 1: one frame per chunk
+  EXPECT_EQ(reader.statistics()->message_start_time, 1'000'000'000u);
+  EXPECT_EQ(reader.statistics()->message_end_time, 1'300'400'000u);
+
+  EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
+  EXPECT_EQ(reader.find_attachment("recorded.graph.json")->data, read_text(graph_file));
+  ASSERT_EQ(reader.metadata().size(), 2u);
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("json"),
+            read_text(calibration_file_));
+
+  // The first colour message, as Foxglove reads it.
+  const std::vector<mcap::Message> messages = reader.read_chunk(reader.chunks().front());
+  ASSERT_EQ(messages.size(), 4u);  // raw, color, truth, mask
+  const json color = json::parse(messages[1].data);
+  EXPECT_EQ(color["encoding"], "bgr8");
+  EXPECT_EQ(color["width"], 40);
+  EXPECT_EQ(color["height"], 30);
+  EXPECT_EQ(color["step"], 120);
+  EXPECT_EQ(color["frame_id"], "color");
+  EXPECT_EQ(color["timestamp"], json({{"sec", 1}, {"nsec", 400000}}));
+  EXPECT_EQ(messages[1].sequence, 3u);
+  EXPECT_EQ(messages[1].log_time, 1'000'400'000u);
+  EXPECT_EQ(messages[1].publish_time, 1'000'400'000u);
+  EXPECT_TRUE(
+      same_pixels(frames_[0].color, mcap::decode_raw_image(messages[1].data, "test").pixels));
+  EXPECT_EQ(json::parse(messages[2].data)["distance_mm"], 500.0);
+
+  const mcap::RecordingInfo info = mcap::recording_info(file);
+  EXPECT_TRUE(info.has_summary);
+  EXPECT_EQ(info.message_count, 14u);
+  EXPECT_EQ(info.chunk_count, 4u);
+  EXPECT_DOUBLE_EQ(info.duration_s(), 0.3004);
+  EXPECT_NE(mcap::format_info(info).find("/truth/mask  2 messages  foxglove.RawImage (json)"),
+            std::string::npos)
+      << mcap::format_info(info);
+}
+
+TEST_F(McapStagesTest, SeeksByTimeWithoutReadingTheChunksBefore) {
+  frames_ = make_frames(10, small_calibration(), 3);
+  const fs::path file = dir_.path() / "seek.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"chunk_size", 1}}).failed);
+  // Damage the first chunk: a player that reads it fails.
+  mcap::McapReader reader(file);
+  const mcap::ChunkIndex first = reader.chunks().front();
+  {
+    std::fstream bytes(file, std::ios::in | std::ios::out | std::ios::binary);
+    bytes.seekp(static_cast<std::streamoff>(first.chunk_start_offset + first.chunk_length - 10));
+    bytes.put('\x55');
+  }
+  const RunResult played = play(file, {{"start_s", 0.25}, {"end_s", 0.65}});
+  ASSERT_FALSE(played.failed) << played.failure;
+  expect_played(PixelFormat::kBgr8, 3, 4);  // depth times 0.3 .. 0.6 s after the first
+  EXPECT_TRUE(play(file).failed);
+}
+
+TEST_F(McapStagesTest, PacesAtTheRecordedRate) {
+  frames_ = make_frames(4, small_calibration(), 3, 50'000'000);
+  const fs::path file = dir_.path() / "paced.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_FALSE(play(file, {{"rate", 1.0}}).failed);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(seconds, 0.15);
+  EXPECT_EQ(captured_.size(), 4u);
+}
+
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& time) { return time.tv_sec + time.tv_usec * 1e-6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+// 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them. The
+// writer compresses on background threads, so what decides whether it keeps up is its
+// CPU time: at 30 frame pairs/s two free cores give 66 ms per pair. Measured 55-65 ms
+// (zstd level 1, this test's process including the feed); the check is a regression
+// guard above that. Wall time is printed too: on cores shared with other work it is
+// lower than what a free machine reaches.
+TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "throughput is measured without sanitizers";
+#endif
+  const json calibration = json::parse(read_text(shipped_calibration_file()));
+  const int count = 45;
+  frames_ = make_frames(count, calibration, 3);
+  cv::RNG random(7);
+  for (TestFrame& frame : frames_) {
+    cv::Mat depth(frame.depth.size(), CV_32F);
+    random.fill(depth, cv::RNG::NORMAL, 20000, 40);
+    depth.convertTo(frame.depth, CV_16U);
+    cv::Mat color(frame.color.size(), CV_32FC3);
+    random.fill(color, cv::RNG::NORMAL, 110, 3);
+    color.convertTo(frame.color, CV_8UC3);
+  }
+  const fs::path file = dir_.path() / "throughput.mcap";
+  const double cpu_start = process_cpu_seconds();
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult recorded =
+      record(file, PixelFormat::kBgr8, {{"calibration", shipped_calibration_file()}});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu_ms_per_pair = (process_cpu_seconds() - cpu_start) * 1e3 / count;
+  ASSERT_FALSE(recorded.failed) << recorded.failure;
+  const double frames_per_second = count / seconds;
+  const double megabytes = static_cast<double>(fs::file_size(file)) / 1e6;
+  std::printf(
+      "mcap.writer: %d frame pairs in %.2f s wall = %.1f frame pairs/s; %.1f ms CPU per pair; "
+      "%.1f MB file\n",
+      count, seconds, frames_per_second, cpu_ms_per_pair, megabytes);
+  RecordProperty("frame_pairs_per_second", std::to_string(frames_per_second));
+  RecordProperty("cpu_ms_per_frame_pair", std::to_string(cpu_ms_per_pair));
+  EXPECT_LT(cpu_ms_per_pair, 80.0);
+}
+
+}  // namespace
+}  // namespace tilth::testing
