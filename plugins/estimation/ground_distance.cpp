@@ -20,6 +20,7 @@
 #include "estimators.h"
 #include "soil_region.h"
 #include "tilth/error.h"
+#include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
 #include "tilth/plugin.h"
@@ -83,12 +84,14 @@ class GroundDistanceEstimator final : public Transform {
 
     thread_local std::vector<float> depths;
     collect_finite(soil.mm, roi, depths);
-    GroundDistance out;
+    const auto message = outputs_.acquire();
+    GroundDistance& out = *message;
+    out = GroundDistance{};  // a reused message keeps its string's buffer
     out.soil_pixels = static_cast<std::int64_t>(depths.size());
     out.soil_fraction = static_cast<double>(depths.size()) / roi.area();
     out.invalid_reason = requirement_.shortfall(out.soil_pixels, roi.area());
     if (out.invalid_reason.empty()) measure(depths, out);
-    frame.emit(0, std::move(out));
+    frame.set_output(0, message);
   }
 
  private:
@@ -127,6 +130,7 @@ class GroundDistanceEstimator final : public Transform {
   const double max_spread_mm_;
   const Logger log_;
   std::once_flag clipping_logged_;
+  MessagePool<GroundDistance> outputs_;
 };
 
 }  // namespace

@@ -92,7 +92,9 @@ struct Scratch {
     for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(n);
     for (auto* values : {&offset, &cell}) values->resize(n);
     reuse_or_create(nearest_mm, cells.rows, cells.columns, CV_32FC1);
-    nearest_mm.setTo(std::numeric_limits<float>::infinity());
+    // Not Mat::setTo, which allocates a scratch buffer every call.
+    std::fill_n(nearest_mm.ptr<float>(), nearest_mm.total(),
+                std::numeric_limits<float>::infinity());
   }
 
   LocatedRow row(const DepthToColor& map, int v) const {
