@@ -2,7 +2,7 @@
 // colour conversion, in-range test, binary residue mask, dilation, then the depth with the
 // residue taken out.
 //
-//   color ──► convert (hsv|lab|bgr) ──► in residue range? ──► dilate ──┐
+//   color ──► convert (hsv|lab|bgr) ──► in residue range? ──► despeckle ──► dilate ──┐
 //     │                                                                ├──► mask
 //     └──► trusted colour? (status kValid, not darker than min_value) ──┤
 //   depth ──► has depth? ───────────────────────────────────────────────┴──► soil_depth
@@ -134,7 +134,11 @@ class ColorThreshold final : public Transform {
         dilation_px_(static_cast<int>(context.params.integer("dilation_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
         kernel_(cv::getStructuringElement(cv::MORPH_RECT,
-                                          {2 * dilation_px_ + 1, 2 * dilation_px_ + 1})) {
+                                          {2 * dilation_px_ + 1, 2 * dilation_px_ + 1})),
+        speckle_kernel_(cv::getStructuringElement(
+            cv::MORPH_RECT, {2 * static_cast<int>(context.params.integer("speckle_px")) + 1,
+                             2 * static_cast<int>(context.params.integer("speckle_px")) + 1})),
+        despeckle_(context.params.integer("speckle_px") > 0) {
     check_bounds_ordered(lower_, upper_, space_);
   }
 
@@ -157,6 +161,9 @@ class ColorThreshold final : public Transform {
     // An untrusted colour may fall in the range by chance (an occluded pixel carries the
     // colour of what hides it); it must not grow into its neighbours.
     cv::subtract(residue, scratch.untrusted, residue);  // saturates: 255 - 255 = 0
+    // Isolated specks (sensor noise, demosaicing artefacts on soil texture) would
+    // otherwise each be dilated into a square of lost soil.
+    if (despeckle_) cv::morphologyEx(residue, residue, cv::MORPH_OPEN, speckle_kernel_);
     if (dilation_px_ > 0) cv::dilate(residue, mask->values, kernel_);
     label_and_subtract(depth.mm, scratch, mask->values, soil->mm);
 
@@ -205,6 +212,8 @@ class ColorThreshold final : public Transform {
   const int dilation_px_;
   const int min_value_;
   const cv::Mat kernel_;
+  const cv::Mat speckle_kernel_;
+  const bool despeckle_;
   MessagePool<ResidueMask> masks_;
   MessagePool<DepthImage> soil_depths_;
 };
@@ -236,6 +245,11 @@ StageDescriptor describe_color_threshold() {
           .range(0, 32)
           .in_unit("px")
           .describe("pixels within this distance of residue are residue too; 0 = no dilation"),
+      ParamSpec::integer("speckle_px", 0)
+          .range(0, 8)
+          .in_unit("px")
+          .describe("residue narrower than 2*speckle_px+1 px is dropped before dilation "
+                    "(noise, demosaicing specks); 0 = keep all"),
       ParamSpec::integer("min_value", 0)
           .range(0, 255)
           .describe("pixels whose brightest channel is below this are unknown (deep shadow)"),

@@ -241,6 +241,23 @@ TEST(ColorThreshold, UnknownWhereColourIsUntrustedOrDepthMissing) {
   EXPECT_EQ(count_finite(out.soil_depth_mm), kSize.area() - 4 - 8);
 }
 
+// Single residue-coloured pixels on soil (colour noise, demosaicing) and a straw 3 px
+// wide: with speckle_px 1 the specks go and the straw stays; with 0 each speck is dilated
+// into a (2*2+1)^2 = 25-pixel hole in the soil.
+TEST(ColorThreshold, SpeckleRemovalKeepsStrawAndDropsSpecks) {
+  Scene scene;
+  scene.paint(cv::Rect(10, 5, 3, 30), kStraw, kStrawDepthMm);
+  for (const cv::Point speck : {cv::Point(30, 10), cv::Point(40, 30), cv::Point(55, 20)}) {
+    scene.paint(cv::Rect(speck, cv::Size(1, 1)), kStraw, kSoilDepthMm);
+  }
+  const Output kept = segment(scene, {{"speckle_px", 0}});
+  const Output cleaned = segment(scene, {{"speckle_px", 1}});
+  const int straw = (3 + 4) * (30 + 4);  // the straw dilated by 2 px on each side
+  EXPECT_EQ(count_equal(cleaned.mask, ResidueMask::kResidue), straw);
+  EXPECT_EQ(count_equal(kept.mask, ResidueMask::kResidue), straw + 3 * 25);
+  EXPECT_EQ(count_finite(cleaned.soil_depth_mm), kSize.area() - straw);
+}
+
 TEST(ColorThreshold, PixelsDarkerThanMinValueAreUnknown) {
   Scene scene;
   scene.paint(cv::Rect(15, 15, 1, 1), cv::Vec3b(20, 20, 29), kSoilDepthMm);
