@@ -55,8 +55,8 @@ std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
       if (ports->empty()) continue;
       out << (ports == &d.inputs ? "Inputs" : "Outputs") << ":\n\n";
       for (const auto& port : *ports) {
-        out << "- `" << port.name << "` (`" << port.type << "`" << (port.required ? "" : ", optional")
-            << "): " << port.description << "\n";
+        out << "- `" << port.name << "` (`" << port.type << "`"
+            << (port.required ? "" : ", optional") << "): " << port.description << "\n";
       }
       out << "\n";
     }
@@ -77,8 +77,8 @@ std::string stage_reference(const StageRegistry::Entry& entry, bool markdown) {
   for (const auto* ports : {&d.inputs, &d.outputs}) {
     out << (ports == &d.inputs ? "  inputs:" : "  outputs:") << (ports->empty() ? " none\n" : "\n");
     for (const auto& port : *ports) {
-      out << "    " << port.name << "  " << port.type << (port.required ? "" : " (optional)") << "  "
-          << port.description << "\n";
+      out << "    " << port.name << "  " << port.type << (port.required ? "" : " (optional)")
+          << "  " << port.description << "\n";
     }
   }
   out << "  parameters:" << (d.params.empty() ? " none\n" : "\n");

@@ -13,8 +13,8 @@ namespace {
 
 using nlohmann::json;
 
-const std::filesystem::path kPaperRig = std::filesystem::path(TILTH_SOURCE_DIR) / "calib" /
-                                        "paper_rig.calib.json";
+const std::filesystem::path kPaperRig =
+    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
 
 json paper_rig_json() {
   std::ifstream in(kPaperRig);
@@ -123,7 +123,8 @@ TEST(Calibration, ErrorsNameTheField) {
 
   json width = paper_rig_json();
   width["depth_camera"]["width"] = 640.5;
-  EXPECT_EQ(parse_error(width), "rig.json:/depth_camera/width: expected a positive integer, got 640.5");
+  EXPECT_EQ(parse_error(width),
+            "rig.json:/depth_camera/width: expected a positive integer, got 640.5");
 }
 
 TEST(Calibration, UnreadableFile) {

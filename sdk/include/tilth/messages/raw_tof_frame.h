@@ -14,7 +14,7 @@ namespace tilth {
 struct RawTofFrame : MessageOf<RawTofFrame> {
   static constexpr std::string_view kTypeName = "tilth.RawTofFrame";
 
-  cv::Mat gray;  // CV_16UC1; 0 = no measurement
+  cv::Mat gray;                          // CV_16UC1; 0 = no measurement
   std::int64_t device_timestamp_ns = 0;  // capture time on this camera's clock
   // The camera's own gray-to-millimetre scale and offset (GenICam Scan3dCoordinateScale /
   // Scan3dCoordinateOffset) when it reports them; they win over the calibration file.
