@@ -11,10 +11,8 @@
 // recovered.
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <deque>
 #include <limits>
-#include <mutex>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -27,12 +25,11 @@
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
 
 namespace tilth::mcap {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
@@ -68,7 +65,7 @@ class McapPlayer final : public Source {
   explicit McapPlayer(const StageContext& context)
       : reader_(context.params.path("path")),
         calibration_(read_calibration(reader_)),
-        rate_(context.params.number("rate")),
+        clock_(context.params.number("rate")),
         log_(context.log) {
     for (const auto& [id, channel] : reader_.channels()) {
       if (channel.topic == kRawTopic) raw_channel_ = id;
@@ -107,19 +104,14 @@ class McapPlayer final : public Source {
       }
       const std::uint64_t time = recorded.raw->log_time;
       if (time < start_ns_ || time > end_ns_) continue;
-      if (!wait_until_due(time)) return false;
+      // Paced by the depth log times, relative to the first frame played.
+      if (!clock_.wait(static_cast<std::int64_t>(time))) return false;
       emit(frame, recorded);
       return true;
     }
   }
 
-  void interrupt() override {
-    {
-      std::lock_guard lock(mutex_);
-      interrupted_ = true;
-    }
-    wake_.notify_all();
-  }
+  void interrupt() override { clock_.interrupt(); }
 
  private:
   // The window as absolute log times, from the recording's first message; the chunks
@@ -168,24 +160,6 @@ class McapPlayer final : public Source {
         frame.mask = std::move(message);
       }
     }
-  }
-
-  // Paces by the depth log times relative to the first frame played. False when
-  // interrupted.
-  bool wait_until_due(std::uint64_t time) {
-    std::unique_lock lock(mutex_);
-    if (rate_ > 0) {
-      if (!first_played_) {
-        first_played_ = time;
-        play_start_ = Clock::now();
-      }
-      const double recorded_ns = static_cast<double>(time - *first_played_);
-      const auto due =
-          play_start_ + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double, std::nano>(recorded_ns / rate_));
-      wake_.wait_until(lock, due, [this] { return interrupted_; });
-    }
-    return !interrupted_;
   }
 
   std::string where(const Message& message) const {
@@ -244,7 +218,7 @@ class McapPlayer final : public Source {
 
   McapReader reader_;
   const RigCalibration calibration_;
-  const double rate_;
+  PlaybackClock clock_;
   const Logger log_;
   std::optional<std::uint16_t> raw_channel_;
   std::optional<std::uint16_t> color_channel_;
@@ -256,12 +230,6 @@ class McapPlayer final : public Source {
   std::vector<ChunkIndex> chunks_;  // the ones to play, in time order
   std::size_t next_chunk_ = 0;
   std::deque<RecordedFrame> ready_;  // decoded from the chunks read so far, not yet played
-
-  std::optional<std::uint64_t> first_played_;
-  Clock::time_point play_start_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool interrupted_ = false;
 };
 
 StageDescriptor describe() {

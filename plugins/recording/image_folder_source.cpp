@@ -4,8 +4,6 @@
 // frame, so a malformed recording fails before the graph runs; the PNGs are read frame
 // by frame.
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
 #include <optional>
 
 #include <opencv2/imgcodecs.hpp>
@@ -16,13 +14,13 @@
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
 
 namespace tilth::recording {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
@@ -40,7 +38,7 @@ class ImageFolderSource final : public Source {
       : folder_(context.params.path("path")),
         recording_(read_recording_json(folder_)),
         frames_(read_frames_csv(folder_ / "frames.csv")),
-        rate_(context.params.number("rate")),
+        clock_(context.params.number("rate")),
         stop_on_missing_(context.params.string("on_missing") == "stop"),
         loop_(context.params.boolean("loop")),
         log_(context.log) {}
@@ -56,11 +54,12 @@ class ImageFolderSource final : public Source {
         next_ = 0;
       }
       if (next_ == 0) {
-        pass_start_ = Clock::now();
+        clock_.restart();
         produced_this_pass_ = false;
       }
       const FrameEntry& entry = frames_[next_++];
-      if (!wait_until_due(entry)) return false;
+      // Paced by the depth timestamps, relative to the first frame of the pass.
+      if (!clock_.wait(entry.depth_timestamp_ns)) return false;
       if (auto images = read_images(entry)) {
         emit(frame, entry, std::move(*images));
         produced_this_pass_ = true;
@@ -69,30 +68,9 @@ class ImageFolderSource final : public Source {
     }
   }
 
-  void interrupt() override {
-    {
-      std::lock_guard lock(mutex_);
-      interrupted_ = true;
-    }
-    wake_.notify_all();
-  }
+  void interrupt() override { clock_.interrupt(); }
 
  private:
-  // Paces by the depth timestamps, relative to the first frame of the pass: a late frame
-  // does not shift the schedule, the frames after it catch up. False when interrupted.
-  bool wait_until_due(const FrameEntry& entry) {
-    std::unique_lock lock(mutex_);
-    if (rate_ > 0) {
-      const double recorded_ns =
-          static_cast<double>(entry.depth_timestamp_ns - frames_.front().depth_timestamp_ns);
-      const auto due =
-          pass_start_ + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double, std::nano>(recorded_ns / rate_));
-      wake_.wait_until(lock, due, [this] { return interrupted_; });
-    }
-    return !interrupted_;
-  }
-
   // The frame's images, checked; nullopt when one is missing or unreadable and
   // on_missing is skip.
   std::optional<FrameImages> read_images(const FrameEntry& entry) const {
@@ -161,18 +139,13 @@ class ImageFolderSource final : public Source {
   const fs::path folder_;
   const RecordingJson recording_;
   const std::vector<FrameEntry> frames_;
-  const double rate_;
+  PlaybackClock clock_;
   const bool stop_on_missing_;
   const bool loop_;
   const Logger log_;
 
   std::size_t next_ = 0;  // the next entry of frames_
   bool produced_this_pass_ = false;
-  Clock::time_point pass_start_;
-
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool interrupted_ = false;
 };
 
 StageDescriptor describe() {

@@ -11,7 +11,6 @@
 // is rendered per frame.
 #include <chrono>
 #include <cmath>
-#include <thread>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -23,6 +22,7 @@
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/messages/residue_mask.h"
+#include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
 
 namespace tilth::synthetic {
@@ -75,7 +75,8 @@ class SceneSource final : public Source {
         seed_(static_cast<std::uint64_t>(context.params.integer("seed"))),
         frames_(context.params.integer("frames") > 0 ? context.params.integer("frames")
                                                      : preset_.frames),
-        period_(context.params.number("fps") > 0 ? 1.0 / context.params.number("fps") : 0.0),
+        clock_(context.params.number("fps") > 0 ? 1.0 : 0.0),
+        pace_ns_(context.params.number("fps") > 0 ? 1e9 / context.params.number("fps") : 0.0),
         noise_mm_at_500_(context.params.number("noise_mm")),
         dropout_(context.params.number("dropout")),
         color_noise_(context.params.number("color_noise")),
@@ -99,14 +100,12 @@ class SceneSource final : public Source {
     const double cell_mm = preset_.track_length_mm > 0 ? 1.0 : 0.5;
     scene_ = std::make_unique<SoilScene>(preset_, soil_z_, area, cell_mm, seed_);
     if (preset_.speed_mm_per_s == 0.0) render(0.0);
-    next_ = std::chrono::steady_clock::now();
   }
 
   bool produce(Frame& frame) override {
-    if (index_ >= first_frame_ + frames_ || interrupted_) return false;
-    if (period_ > 0) {
-      std::this_thread::sleep_until(next_);
-      next_ += std::chrono::nanoseconds(static_cast<std::int64_t>(period_ * 1e9));
+    if (index_ >= first_frame_ + frames_) return false;
+    if (!clock_.wait(static_cast<std::int64_t>(static_cast<double>(index_) * pace_ns_))) {
+      return false;
     }
     const double shift = preset_.speed_mm_per_s * static_cast<double>(index_) / kSimulatedCameraFps;
     if (preset_.speed_mm_per_s != 0.0) render(shift);
@@ -134,7 +133,7 @@ class SceneSource final : public Source {
     return true;
   }
 
-  void interrupt() override { interrupted_ = true; }
+  void interrupt() override { clock_.interrupt(); }
 
  private:
   void prepare_rays() {
@@ -273,7 +272,8 @@ class SceneSource final : public Source {
   ScenePreset preset_;
   const std::uint64_t seed_;
   const std::int64_t frames_;
-  const double period_;
+  PlaybackClock clock_;
+  const double pace_ns_;  // between frames, at the `fps` parameter
   const double noise_mm_at_500_;
   const double dropout_;
   const double color_noise_;
@@ -291,8 +291,6 @@ class SceneSource final : public Source {
   cv::Mat radiance_;    // CV_32FC3: reflectance x light
   std::int64_t index_;
   const std::int64_t first_frame_ = index_;
-  std::atomic<bool> interrupted_{false};
-  std::chrono::steady_clock::time_point next_;
 };
 
 StageDescriptor describe() {

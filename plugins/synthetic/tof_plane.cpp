@@ -3,11 +3,11 @@
 // with Gaussian range noise. Defaults are the paper's blaze-101 values.
 #include <chrono>
 #include <cmath>
-#include <thread>
 
 #include <opencv2/core.hpp>
 
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
 
 namespace tilth::synthetic {
@@ -17,10 +17,8 @@ class TofPlane final : public Source {
  public:
   explicit TofPlane(const StageContext& context)
       : frames_(context.params.integer("frames")),
-        period_(context.params.number("fps") > 0
-                    ? std::chrono::nanoseconds(
-                          static_cast<std::int64_t>(1e9 / context.params.number("fps")))
-                    : std::chrono::nanoseconds(0)),
+        clock_(context.params.number("fps") > 0 ? 1.0 : 0.0),
+        pace_ns_(context.params.number("fps") > 0 ? 1e9 / context.params.number("fps") : 0.0),
         noise_(static_cast<std::uint64_t>(context.params.integer("seed"))) {
     const double f = context.params.number("focal_px");
     const double cx = context.params.number("cx");
@@ -40,14 +38,12 @@ class TofPlane final : public Source {
       }
     }
     noise_gray_ = context.params.number("noise_mm") / mu;
-    next_ = std::chrono::steady_clock::now();
   }
 
   bool produce(Frame& frame) override {
     if (frames_ > 0 && index_ >= static_cast<std::uint64_t>(frames_)) return false;
-    if (period_.count() > 0) {
-      std::this_thread::sleep_until(next_);
-      next_ += period_;
+    if (!clock_.wait(static_cast<std::int64_t>(static_cast<double>(index_) * pace_ns_))) {
+      return false;
     }
     cv::Mat gray_float = gray_mean_.clone();
     if (noise_gray_ > 0) {
@@ -65,13 +61,15 @@ class TofPlane final : public Source {
     return true;
   }
 
+  void interrupt() override { clock_.interrupt(); }
+
  private:
   const std::int64_t frames_;
-  const std::chrono::nanoseconds period_;
+  PlaybackClock clock_;
+  const double pace_ns_;  // between frames, at the `fps` parameter
   cv::RNG noise_;
   cv::Mat gray_mean_;
   double noise_gray_ = 0.0;
-  std::chrono::steady_clock::time_point next_;
   std::uint64_t index_ = 0;
 };
 
