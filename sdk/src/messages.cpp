@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "tilth/messages/camera_status.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
@@ -50,6 +51,15 @@ std::optional<PixelFormat> parse_pixel_format(std::string_view name) {
 
 int channels(PixelFormat format) {
   return format == PixelFormat::kBgr8 || format == PixelFormat::kRgb8 ? 3 : 1;
+}
+
+std::string CameraStatus::summary() const {
+  std::ostringstream out;
+  out << camera << (streaming ? " streaming" : " not streaming");
+  if (!problem.empty()) out << " (" << problem << ")";
+  out << ", " << completed << " complete, " << incomplete << " incomplete, " << lost << " lost, "
+      << late << " late";
+  return out.str();
 }
 
 std::string RawTofFrame::summary() const { return "raw ToF " + size_of(gray); }

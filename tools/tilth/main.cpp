@@ -4,6 +4,7 @@
 #include <string>
 
 #include "commands.h"
+#include "external_commands.h"
 #include "tilth/error.h"
 
 namespace {
@@ -20,10 +21,20 @@ commands:
   describe TYPE    print a stage type's ports and full parameter schema
   dot GRAPH        print a graph as Graphviz dot
 
-'tilth COMMAND --help' describes a command's options.
+'tilth COMMAND --help' describes a command's options. Any other COMMAND runs the
+program tilth-COMMAND found next to tilth or on PATH.
 Plugins are searched next to the graph file, in TILTH_PLUGIN_PATH, and in the build
 and install plugin directories.
 )";
+
+void print_usage() {
+  std::cout << kUsage;
+  const auto others = tilth::cli::external_commands();
+  if (others.empty()) return;
+  std::cout << "\nother commands found:";
+  for (const auto& name : others) std::cout << " " << name;
+  std::cout << "\n";
+}
 
 }  // namespace
 
@@ -31,7 +42,7 @@ int main(int argc, char** argv) {
   using namespace tilth::cli;
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
       std::strcmp(argv[1], "help") == 0) {
-    std::cout << kUsage;
+    print_usage();
     return argc < 2 ? kExitUsage : kExitOk;
   }
   const std::string command = argv[1];
@@ -41,6 +52,7 @@ int main(int argc, char** argv) {
     if (command == "plugins") return plugins_command(argc, argv);
     if (command == "describe") return describe_command(argc, argv);
     if (command == "dot") return dot_command(argc, argv);
+    exec_external_command(command, argc, argv);
   } catch (const tilth::Error& error) {
     std::cerr << "tilth " << command << ": " << error.what() << "\n";
     return kExitUsage;
