@@ -46,6 +46,7 @@ class Validator {
     resolve_nodes();
     resolve_edges();
     check_inputs_connected();
+    check_synchronized_sources();
     if (!has_source_) diagnostics_.add({graph_.file.string(), ""}, "the graph has no source stage");
     const std::vector<std::size_t> order = topological_order();
     diagnostics_.throw_if_any();
@@ -188,6 +189,45 @@ class Validator {
                          "none of its inputs is connected (it needs at least one)");
       }
     }
+  }
+
+  // A synchronizer's inputs come straight from sources, and those sources enter the graph
+  // through it alone: the runtime admits what it emits, not their frames.
+  void check_synchronized_sources() {
+    std::vector<std::optional<std::size_t>> synchronized_by(nodes_.size());
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (kind(i) != StageKind::kSynchronizer) continue;
+      for (const auto& feed : inputs_[i]) {
+        if (!feed) continue;
+        const std::size_t from = feed->binding.node;
+        const auto& edge = graph_.edges[feed->edge];
+        if (kind(from) != StageKind::kSource) {
+          diagnostics_.add(edge.where, edge.to + " belongs to synchronizer '" + nodes_[i].name +
+                                           "', whose inputs must come straight from sources; '" +
+                                           nodes_[from].name + "' is a " +
+                                           std::string(to_string(kind(from))));
+        } else {
+          synchronized_by[from] = i;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      for (const auto& feed : inputs_[i]) {
+        if (!feed) continue;
+        const auto& synchronizer = synchronized_by[feed->binding.node];
+        if (!synchronizer || *synchronizer == i) continue;
+        const auto& edge = graph_.edges[feed->edge];
+        diagnostics_.add(edge.where, "source '" + nodes_[feed->binding.node].name +
+                                         "' feeds synchronizer '" + nodes_[*synchronizer].name +
+                                         "', so it enters the graph there and can feed nothing "
+                                         "else; connect '" +
+                                         nodes_[i].name + "' to the synchronizer's outputs");
+      }
+    }
+  }
+
+  StageKind kind(std::size_t node) const {
+    return nodes_[node].stage ? nodes_[node].stage->descriptor.kind() : StageKind::kTransform;
   }
 
   std::set<std::size_t> predecessors(std::size_t node) const {

@@ -38,13 +38,17 @@ struct Node {
   Source* source = nullptr;
   Transform* transform = nullptr;
   Sink* sink = nullptr;
+  Synchronizer* synchronizer = nullptr;
+  std::optional<std::size_t> synchronized_by;  // a source: the synchronizer it feeds
+  std::size_t admission_slot = 0;              // a source or synchronizer: its FrameAdmission slot
+  std::size_t sources_ended = 0;               // a synchronizer: its sources whose streams ended
   std::vector<std::size_t> predecessors;  // distinct node indices
   // Per input port: (predecessor slot, its output port), or none for an unconnected
   // optional input.
   std::vector<std::optional<std::pair<std::size_t, std::size_t>>> input_of;
   std::unique_ptr<KeyedJoin> join;
   bool ordered = false;
-  std::mutex order_mutex;
+  std::mutex order_mutex;  // also serialises a synchronizer's accept() and its offers
   SequenceReorder<std::vector<BundlePtr>> reorder;
   // Bundles travel through this inbox, under its mutex, and the flow graph carries one
   // token per bundle: the hand-over between threads is then visible to ThreadSanitizer,
@@ -71,6 +75,33 @@ struct Node {
   std::string label() const { return "node '" + spec.name + "' (" + type() + ")"; }
 };
 
+// The frames a synchronizer emits during one accept() call.
+class EmittedFrames final : public Synchronizer::Output {
+ public:
+  EmittedFrames(std::size_t node, std::size_t outputs) : node_(node), outputs_(outputs) {}
+
+  Frame& emit() override {
+    auto bundle = std::make_shared<Bundle>();
+    bundle->node = node_;
+    bundle->outputs.resize(outputs_);
+    frames_.emplace_back(FrameInfo{}, std::span<const Packet>{}, bundle->outputs);
+    bundles_.push_back(std::move(bundle));
+    return frames_.back();
+  }
+
+  // The bundles, each with the capture identity set on its Frame.
+  std::vector<std::shared_ptr<Bundle>> take() {
+    for (std::size_t i = 0; i < bundles_.size(); ++i) bundles_[i]->info = frames_[i].info();
+    return std::move(bundles_);
+  }
+
+ private:
+  const std::size_t node_;
+  const std::size_t outputs_;
+  std::deque<Frame> frames_;  // a deque: emit() hands out references that must stay valid
+  std::vector<std::shared_ptr<Bundle>> bundles_;
+};
+
 }  // namespace
 
 class Runtime::Impl {
@@ -80,7 +111,7 @@ class Runtime::Impl {
     make_stages(registry);
     wire();
     admission_ = std::make_unique<FrameAdmission>(
-        sources_.size(), graph_.runtime.max_in_flight, graph_.runtime.when_full,
+        admission_slots_, graph_.runtime.max_in_flight, graph_.runtime.when_full,
         [this](std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> bundles) {
           admit(sequence, std::move(bundles));
         },
@@ -160,10 +191,12 @@ class Runtime::Impl {
       node->source = dynamic_cast<Source*>(stage);
       node->transform = dynamic_cast<Transform*>(stage);
       node->sink = dynamic_cast<Sink*>(stage);
+      node->synchronizer = dynamic_cast<Synchronizer*>(stage);
       const StageKind kind = node->spec.stage->descriptor.kind();
       const bool matches = (kind == StageKind::kSource && node->source) ||
                            (kind == StageKind::kTransform && node->transform) ||
-                           (kind == StageKind::kSink && node->sink);
+                           (kind == StageKind::kSink && node->sink) ||
+                           (kind == StageKind::kSynchronizer && node->synchronizer);
       if (stage != nullptr && !matches) {
         failures += std::string(failures.empty() ? "" : "\n") + node->label() +
                     ": the stage object is not a " + std::string(to_string(kind)) +
@@ -192,7 +225,10 @@ class Runtime::Impl {
         node.input_of.emplace_back(
             std::pair<std::size_t, std::size_t>(slot - node.predecessors.begin(), input->port));
       }
-      if (node.source) continue;
+      if (node.synchronizer) {
+        for (std::size_t from : node.predecessors) nodes_[from]->synchronized_by = i;
+      }
+      if (node.source || node.synchronizer) continue;
       node.join = std::make_unique<KeyedJoin>(node.predecessors.size());
       node.ordered = node.sink || node.spec.stage->descriptor.concurrency == Concurrency::kSerial;
       node.flow_node = std::make_unique<tbb::flow::function_node<tbb::flow::continue_msg>>(
@@ -203,15 +239,23 @@ class Runtime::Impl {
             return tbb::flow::continue_msg();
           });
     }
+    // Frames enter the graph at sources, except where a synchronizer lines sources up.
+    for (auto& node : nodes_) {
+      if ((node->source && !node->synchronized_by) || node->synchronizer) {
+        node->admission_slot = admission_slots_++;
+      }
+    }
   }
 
-  // A source's thread: produce, stamp, offer, until the stream ends or the graph stops.
+  // A source's thread: produce, stamp, offer (or hand to its synchronizer), until the
+  // stream ends or the graph stops.
   void pump(std::size_t source_index) {
-    Node& node = *nodes_[sources_[source_index]];
+    const std::size_t index = sources_[source_index];
+    Node& node = *nodes_[index];
     const std::size_t outputs = node.spec.stage->descriptor.outputs.size();
     while (!stopping_) {
       auto bundle = std::make_shared<Bundle>();
-      bundle->node = sources_[source_index];
+      bundle->node = index;
       bundle->outputs.resize(outputs);
       Frame frame(FrameInfo{}, {}, bundle->outputs);
       bool more = false;
@@ -226,9 +270,51 @@ class Runtime::Impl {
       node.latency.record(steady_now_ns() - begin);
       bundle->info = frame.info();
       if (bundle->info.host_timestamp_ns == 0) bundle->info.host_timestamp_ns = host_now_ns();
-      if (!admission_->offer(source_index, std::move(bundle))) break;
+      const bool open = node.synchronized_by
+                            ? synchronize(*node.synchronized_by, std::move(bundle))
+                            : admission_->offer(node.admission_slot, std::move(bundle));
+      if (!open) break;
     }
-    admission_->end_of_stream(source_index);
+    if (node.synchronized_by) {
+      end_synchronized_stream(*node.synchronized_by);
+    } else {
+      admission_->end_of_stream(node.admission_slot);
+    }
+  }
+
+  // A synchronizer's stream ends with the last of its sources' streams.
+  void end_synchronized_stream(std::size_t index) {
+    Node& node = *nodes_[index];
+    std::lock_guard lock(node.order_mutex);
+    if (++node.sources_ended == node.predecessors.size()) {
+      admission_->end_of_stream(node.admission_slot);
+    }
+  }
+
+  // Hands one source frame to a synchronizer and offers what it emits; false once
+  // admission is closed.
+  bool synchronize(std::size_t index, BundlePtr arrived) {
+    Node& node = *nodes_[index];
+    std::lock_guard lock(node.order_mutex);
+    std::vector<Packet> inputs(node.input_of.size());
+    for (std::size_t p = 0; p < inputs.size(); ++p) {
+      const auto& from = node.input_of[p];
+      if (from && node.predecessors[from->first] == arrived->node) {
+        inputs[p] = arrived->outputs[from->second];
+      }
+    }
+    const Frame frame(arrived->info, inputs, {});
+    EmittedFrames emitted(index, node.spec.stage->descriptor.outputs.size());
+    const std::int64_t begin = steady_now_ns();
+    const bool ok =
+        call_guarded(node, arrived->info, [&] { node.synchronizer->accept(frame, emitted); });
+    node.latency.record(steady_now_ns() - begin);
+    if (!ok) return !stopping_;
+    for (auto& bundle : emitted.take()) {
+      if (bundle->info.host_timestamp_ns == 0) bundle->info.host_timestamp_ns = host_now_ns();
+      if (!admission_->offer(node.admission_slot, std::move(bundle))) return false;
+    }
+    return true;
   }
 
   void admit(std::uint64_t sequence, std::vector<std::shared_ptr<Bundle>> bundles) {
@@ -374,6 +460,7 @@ class Runtime::Impl {
   tbb::flow::graph flow_;  // before nodes_: outlives every flow node
   std::vector<std::unique_ptr<Node>> nodes_;
   std::vector<std::size_t> sources_;
+  std::size_t admission_slots_ = 0;
   std::size_t terminal_count_ = 0;
   std::unique_ptr<FrameAdmission> admission_;
   std::atomic<bool> stopping_{false};

@@ -25,6 +25,11 @@ std::string check_descriptor(const StageDescriptor& descriptor) {
   if (descriptor.inputs.empty() && descriptor.outputs.empty()) {
     return "stage type '" + descriptor.type + "' has no ports";
   }
+  if (descriptor.input_timing == InputTiming::kOnArrival &&
+      (descriptor.inputs.empty() || descriptor.outputs.empty())) {
+    return "stage type '" + descriptor.type +
+           "' takes its inputs on arrival (a synchronizer) and so needs inputs and outputs";
+  }
   std::set<std::string> names;
   for (const auto& spec : descriptor.params) {
     if (!names.insert(spec.name).second) {

@@ -8,6 +8,8 @@ Stage::~Stage() = default;
 Source::~Source() = default;
 Transform::~Transform() = default;
 Sink::~Sink() = default;
+Synchronizer::~Synchronizer() = default;
+Synchronizer::Output::~Output() = default;
 
 void Frame::set_capture(std::uint64_t frame_id, std::int64_t device_timestamp_ns,
                         std::int64_t host_timestamp_ns) {
@@ -40,6 +42,8 @@ std::string_view to_string(StageKind kind) {
       return "transform";
     case StageKind::kSink:
       return "sink";
+    case StageKind::kSynchronizer:
+      return "synchronizer";
   }
   return "?";
 }
@@ -47,6 +51,7 @@ std::string_view to_string(StageKind kind) {
 StageKind StageDescriptor::kind() const {
   if (inputs.empty()) return StageKind::kSource;
   if (outputs.empty()) return StageKind::kSink;
+  if (input_timing == InputTiming::kOnArrival) return StageKind::kSynchronizer;
   return StageKind::kTransform;
 }
 

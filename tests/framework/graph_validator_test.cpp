@@ -106,6 +106,20 @@ TEST_F(GraphValidatorTest, InputFedTwice) {
             at("/edges/1") + ": input out.in is already fed by a.out (" + at("/edges/0") + ")");
 }
 
+TEST_F(GraphValidatorTest, SynchronizerInputsComeStraightFromSourcesThatFeedNothingElse) {
+  EXPECT_EQ(errors(R"({"nodes": {"a": {"type": "test.counter"}, "b": {"type": "test.counter"},
+                                 "d": {"type": "test.delay"}, "pair": {"type": "test.pair_equal"},
+                                 "out": {"type": "test.record"}, "raw": {"type": "test.record"}},
+                       "edges": [["a.out", "d.in"], ["d.out", "pair.a"], ["b.out", "pair.b"],
+                                 ["b.out", "raw.in"], ["pair.sum", "out.in"]]})"),
+            at("/edges/1") +
+                ": pair.a belongs to synchronizer 'pair', whose inputs must come straight from "
+                "sources; 'd' is a transform\n" +
+                at("/edges/3") +
+                ": source 'b' feeds synchronizer 'pair', so it enters the graph there and can "
+                "feed nothing else; connect 'raw' to the synchronizer's outputs");
+}
+
 TEST_F(GraphValidatorTest, CycleIsNamed) {
   EXPECT_EQ(errors(R"({"nodes": {"src": {"type": "test.counter"}, "sum": {"type": "test.add"},
                                  "d": {"type": "test.delay"}, "out": {"type": "test.record"}},
@@ -123,7 +137,7 @@ TEST_F(GraphValidatorTest, ParametersAreChecked) {
                  "edges": [["src.out", "out.in"], ["src.out", "p.in"]]})"),
       at("/nodes/src/params/cont") +
           ": unknown parameter 'cont' of test.counter; did you mean 'count'? (its parameters: "
-          "'count', 'period_us')\n" +
+          "'count', 'period_us', 'step')\n" +
           at("/nodes/src/params/period_us") +
           ": parameter 'period_us': expected an integer >= 0, got -1\n" +
           at("/nodes/out/params/delay_us") +

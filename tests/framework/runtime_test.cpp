@@ -225,6 +225,32 @@ TEST_F(RuntimeTest, MultipleSourcesJoinFrameByFrame) {
   EXPECT_EQ(values("out"), range(50, 2));  // ends with the shorter stream
 }
 
+// Two sources at their own pace (0,1,2,... fast; 0,2,4,... slow) meet at a synchronizer:
+// only equal counts pair, the graph's frames are numbered densely from the pairs, and the
+// stream ends with the last source.
+TEST_F(RuntimeTest, SynchronizerLinesUpSourcesOnTheirOwnClocks) {
+  const RunResult result = run(R"({
+    "nodes": {"fast": {"type": "test.counter", "params": {"count": 50}},
+              "slow": {"type": "test.counter", "params": {"count": 30, "step": 2,
+                                                          "period_us": 200}},
+              "pair": {"type": "test.pair_equal"},
+              "d": {"type": "test.delay", "params": {"max_delay_us": 500}},
+              "out": {"type": "test.record"}},
+    "edges": [["fast.out", "pair.a"], ["slow.out", "pair.b"], ["pair.sum", "d.in"],
+              ["d.out", "out.in"]],
+    "runtime": {"max_in_flight": 4, "when_full": "block"}
+  })");
+  EXPECT_FALSE(result.failed) << result.failure;
+  EXPECT_EQ(values("out"), range(25, 4));  // 2v for v = 0, 2, ..., 48
+  EXPECT_EQ(sequences("out"), dense(25));
+  std::vector<std::uint64_t> frame_ids;
+  for (const auto& frame : sink_log("out").frames) frame_ids.push_back(frame.info.frame_id);
+  EXPECT_EQ(frame_ids.back(), 48u);
+  EXPECT_EQ(result.metrics.frames_admitted, 25u);
+  EXPECT_EQ(result.metrics.stages[2].node, "pair");
+  EXPECT_EQ(result.metrics.stages[2].latency.count, 80u);  // one accept() per source frame
+}
+
 TEST_F(RuntimeTest, EveryStageIsTimed) {
   const RunResult result = run(R"({
     "nodes": {"src": {"type": "test.counter", "params": {"count": 40}},

@@ -1,6 +1,7 @@
 #include "test_stages.h"
 
 #include <chrono>
+#include <deque>
 #include <map>
 #include <memory>
 #include <random>
@@ -22,17 +23,19 @@ void note_max(std::atomic<int>& max, int value) {
   }
 }
 
-// Emits 0, 1, 2, ... `count` frames (0: endless); optionally paced.
+// Emits 0, step, 2 step, ... `count` frames (0: endless); optionally paced.
 class Counter final : public Source {
  public:
   explicit Counter(const StageContext& c)
-      : count_(c.params.integer("count")), period_us_(c.params.integer("period_us")) {}
+      : count_(c.params.integer("count")),
+        period_us_(c.params.integer("period_us")),
+        step_(c.params.integer("step")) {}
   bool produce(Frame& frame) override {
-    if (count_ > 0 && next_ >= count_) return false;
+    if (count_ > 0 && produced_ >= count_) return false;
     if (period_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(period_us_));
-    frame.set_capture(static_cast<std::uint64_t>(next_), next_ * 1000, 0);
-    frame.emit(0, Count(next_));
-    ++next_;
+    const std::int64_t value = produced_++ * step_;
+    frame.set_capture(static_cast<std::uint64_t>(value), value * 1000, 0);
+    frame.emit(0, Count(value));
     return true;
   }
   void interrupt() override { interrupted_ = true; }
@@ -40,7 +43,8 @@ class Counter final : public Source {
  private:
   const std::int64_t count_;
   const std::int64_t period_us_;
-  std::int64_t next_ = 0;
+  const std::int64_t step_;
+  std::int64_t produced_ = 0;
   std::atomic<bool> interrupted_{false};
 };
 
@@ -89,6 +93,30 @@ class Fail final : public Transform {
 
  private:
   const std::int64_t every_;
+};
+
+// Pairs equal counts from its two inputs, whatever order they arrive in, and emits their
+// sum; a count whose partner never comes is dropped once the other side has passed it.
+class PairEqual final : public Synchronizer {
+ public:
+  explicit PairEqual(const StageContext&) {}
+  void accept(const Frame& arrived, Output& output) override {
+    const std::size_t side = arrived.input(0).empty() ? 1 : 0;
+    const std::int64_t value = arrived.input<Count>(side).value;
+    auto& other = pending_[1 - side];
+    while (!other.empty() && other.front() < value) other.pop_front();
+    if (other.empty() || other.front() != value) {
+      pending_[side].push_back(value);
+      return;
+    }
+    other.pop_front();
+    Frame& frame = output.emit();
+    frame.set_capture(static_cast<std::uint64_t>(value), value * 1000, 0);
+    frame.emit(0, Count(2 * value));
+  }
+
+ private:
+  std::deque<std::int64_t> pending_[2];
 };
 
 class Record final : public Sink {
@@ -154,7 +182,8 @@ void register_test_stages(StageRegistry& registry) {
   registry.add(
       describe("test.counter", {}, {count("out")},
                {ParamSpec::integer("count", 10).range(0, std::nullopt).describe("frames"),
-                ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace")},
+                ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace"),
+                ParamSpec::integer("step", 1).range(1, std::nullopt).describe("increment")},
                Concurrency::kSerial, factory<Counter>()),
       "test_stages");
   registry.add(describe("test.delay", {count("in")}, {count("out")},
@@ -168,6 +197,10 @@ void register_test_stages(StageRegistry& registry) {
   registry.add(describe("test.add", {count("a"), count("b")}, {count("sum")}, {},
                         Concurrency::kParallel, factory<Add>()),
                "test_stages");
+  auto pair = describe("test.pair_equal", {count("a"), count("b")}, {count("sum")}, {},
+                       Concurrency::kSerial, factory<PairEqual>());
+  pair.input_timing = InputTiming::kOnArrival;
+  registry.add(std::move(pair), "test_stages");
   registry.add(describe("test.fail", {count("in")}, {count("out")},
                         {ParamSpec::integer("every", 0).range(0, std::nullopt).describe("period"),
                          ParamSpec::boolean("fail_to_start", false).describe("throw when made")},

@@ -1,6 +1,7 @@
 // Stage types for the framework tests, registered in-process (StageRegistry::add):
-// a counting source, a parallel transform with a settable delay, a two-input adder,
-// a stage that throws on chosen frames, and a sink that records what it receives.
+// a counting source, a parallel transform with a settable delay, a two-input adder, a
+// synchronizer pairing equal counts, a stage that throws on chosen frames, and a sink
+// that records what it receives.
 #pragma once
 
 #include <atomic>

@@ -1,8 +1,10 @@
-// The three kinds of stage a plugin implements. A source has only outputs, a sink only
-// inputs, a transform both. Stages never keep a borrowed Frame past the call.
+// The kinds of stage a plugin implements. A source has only outputs, a sink only inputs,
+// a transform both; a synchronizer is a transform whose inputs are not joined by frame.
+// Stages never keep a borrowed Frame past the call.
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 
 #include "tilth/frame.h"
 
@@ -39,6 +41,28 @@ class Sink : public Stage {
   virtual void consume(const Frame& frame) = 0;
   // The frame did not reach this sink: an upstream stage failed or produced nothing.
   virtual void skipped(const FrameInfo& /*info*/) {}
+};
+
+// Lines up sources that run on their own clocks (free-running cameras) into the graph's
+// frames. Its inputs come straight from sources; the runtime hands it each source frame
+// as it arrives, one call at a time, and it emits a frame of the graph whenever it has
+// matched one. What it emits is admitted like a source's frame (frames in flight,
+// when_full), so it is where the sources it lines up enter the graph.
+class Synchronizer : public Stage {
+ public:
+  // The frames one call emits.
+  class Output {
+   public:
+    virtual ~Output();
+    // Starts a frame of the graph: set its capture identity and outputs on the Frame
+    // returned, which stays valid until accept() returns.
+    virtual Frame& emit() = 0;
+  };
+
+  ~Synchronizer() override;
+  // `arrived` holds one source frame: its packets on the inputs that source feeds, the
+  // other inputs empty; arrived.info() is that source's capture identity.
+  virtual void accept(const Frame& arrived, Output& output) = 0;
 };
 
 }  // namespace tilth

@@ -19,7 +19,12 @@ enum class Concurrency {
   kParallel,  // stateless: frames may run concurrently
 };
 
-enum class StageKind { kSource, kTransform, kSink };
+enum class InputTiming {
+  kJoinedByFrame,  // the runtime joins the inputs of one frame and calls the stage once
+  kOnArrival,      // each source frame is handed over as it arrives: a Synchronizer
+};
+
+enum class StageKind { kSource, kTransform, kSink, kSynchronizer };
 using StageFactory = std::function<std::unique_ptr<Stage>(const StageContext&)>;
 std::string_view to_string(StageKind kind);
 
@@ -30,6 +35,7 @@ struct StageDescriptor {
   std::vector<PortSpec> outputs;
   std::vector<ParamSpec> params;
   Concurrency concurrency = Concurrency::kSerial;
+  InputTiming input_timing = InputTiming::kJoinedByFrame;
   StageFactory create;
 
   StageKind kind() const;
