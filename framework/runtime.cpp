@@ -42,7 +42,7 @@ struct Node {
   std::optional<std::size_t> synchronized_by;  // a source: the synchronizer it feeds
   std::size_t admission_slot = 0;              // a source or synchronizer: its FrameAdmission slot
   std::size_t sources_ended = 0;               // a synchronizer: its sources whose streams ended
-  std::vector<std::size_t> predecessors;  // distinct node indices
+  std::vector<std::size_t> predecessors;       // distinct node indices
   // Per input port: (predecessor slot, its output port), or none for an unconnected
   // optional input.
   std::vector<std::optional<std::pair<std::size_t, std::size_t>>> input_of;
