@@ -5,9 +5,11 @@
 //     "edges": [["a.out", "b.in"], {"from": "a.out", "to": "b.in"}],
 //     "runtime": {"max_in_flight": 4, "when_full": "block", "on_error": "skip"} }
 // A node of the including file with the name of an included node replaces it when it
-// names a type, and otherwise overrides only the parameters it lists.
+// names a type, overrides only the parameters it lists otherwise, and removes it (with
+// its edges) when it is null.
 #include "framework/graph_loader.h"
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -293,12 +295,18 @@ class Loader {
         diagnostics_.add(where, "node names must be non-empty, without '.', and not 'runtime'");
         continue;
       }
+      const std::string name = prefix + local_name;
+      if (body.is_null()) {
+        remove_node(name, where);
+        continue;
+      }
       if (!body.is_object()) {
-        diagnostics_.add(where, "expected {\"type\": ..., \"params\": ...}");
+        diagnostics_.add(where,
+                         "expected {\"type\": ..., \"params\": ...}, or null to remove "
+                         "an included node");
         continue;
       }
       check_keys(body, where, kNodeKeys, "node");
-      const std::string name = prefix + local_name;
       NodeSpec* node = find_node(name);
       if (body.contains("type")) {
         if (!body["type"].is_string()) {
@@ -328,6 +336,23 @@ class Loader {
             nlohmann::json(substitute(value, variables, param_where)), param_where, dir, {}};
       }
     }
+  }
+
+  // An included node and every edge to or from it leave the graph.
+  void remove_node(const std::string& name, const Location& where) {
+    const auto node = std::find_if(graph_.nodes.begin(), graph_.nodes.end(),
+                                   [&](const NodeSpec& n) { return n.name == name; });
+    if (node == graph_.nodes.end()) {
+      diagnostics_.add(where, "null removes an included node, but there is no node '" + name + "'" +
+                                  did_you_mean(name, node_names()));
+      return;
+    }
+    graph_.nodes.erase(node);
+    const auto touches = [&](const std::string& endpoint) {
+      return endpoint.substr(0, endpoint.rfind('.')) == name;
+    };
+    std::erase_if(graph_.edges,
+                  [&](const EdgeSpec& edge) { return touches(edge.from) || touches(edge.to); });
   }
 
   void load_edges(const json& document, const Location& root, const std::string& prefix) {

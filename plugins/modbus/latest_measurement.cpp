@@ -35,11 +35,16 @@ void LatestMeasurement::update_missing(Clock::time_point arrived) {
   last_frame_missing_ = true;
 }
 
+void LatestMeasurement::update_cameras(bool streaming) {
+  std::lock_guard lock(mutex_);
+  cameras_streaming_ = streaming;
+}
+
 RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
   std::lock_guard lock(mutex_);
   RegisterValues values;
-  values.camera_ok = last_frame_ && now - *last_frame_ <= stale_timeout_;
-  values.pipeline_error = last_frame_missing_;
+  values.camera_ok = last_frame_ && now - *last_frame_ <= stale_timeout_ && cameras_streaming_;
+  values.pipeline_error = last_frame_missing_ && cameras_streaming_;
   if (!measurement_) {
     values.stale = true;
     values.age = std::chrono::milliseconds::max();  // never: saturates
@@ -48,7 +53,7 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
   const auto since_arrival =
       std::chrono::duration_cast<std::chrono::milliseconds>(now - measurement_->arrived);
   values.stale = since_arrival > stale_timeout_;
-  values.valid = measurement_->valid && !values.stale;
+  values.valid = measurement_->valid && !values.stale && !last_frame_missing_;
   values.too_little_soil = measurement_->too_little_soil;
   values.distance_mm = measurement_->distance_mm;
   values.soil_fraction = measurement_->soil_fraction;

@@ -24,8 +24,11 @@ class LatestMeasurement {
   // `capture_age`: how old the frame already was when it arrived here.
   void update(std::uint64_t frame_id, const GroundDistance& distance, Clock::time_point arrived,
               std::chrono::milliseconds capture_age);
-  // A frame arrived without a measurement: a stage upstream failed on it.
+  // A frame arrived without a measurement: a stage upstream failed on it, or the
+  // cameras delivered no images for it.
   void update_missing(Clock::time_point arrived);
+  // What the cameras said with the newest frame.
+  void update_cameras(bool streaming);
 
   // Everything but the heartbeat, which belongs to the link that publishes the values.
   RegisterValues values_at(Clock::time_point now) const;
@@ -47,6 +50,7 @@ class LatestMeasurement {
   std::optional<Measurement> measurement_;
   std::optional<Clock::time_point> last_frame_;  // with or without a measurement
   bool last_frame_missing_ = false;
+  bool cameras_streaming_ = true;  // until a camera status says otherwise
 };
 
 // The estimator says why a measurement is invalid in words; "too little soil" is the

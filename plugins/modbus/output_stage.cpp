@@ -11,6 +11,7 @@
 #include "modbus_client.h"
 #include "modbus_server.h"
 #include "register_map.h"
+#include "tilth/messages/camera_status.h"
 #include "tilth/plugin.h"
 
 namespace tilth::modbus {
@@ -34,7 +35,7 @@ std::string ipv4_address(const Params& params, bool client) {
 
 class ModbusOutput final : public Sink {
  public:
-  enum Port { kDistance = 0 };
+  enum Port { kDistance = 0, kCameras = 1 };
 
   explicit ModbusOutput(const StageContext& context)
       : latest_(std::chrono::milliseconds(context.params.integer("stale_timeout_ms"))) {
@@ -59,6 +60,13 @@ class ModbusOutput final : public Sink {
   }
 
   void consume(const Frame& frame) override {
+    if (const Packet& cameras = frame.input(kCameras); !cameras.empty()) {
+      latest_.update_cameras(cameras.get<CameraStatus>().streaming);
+    }
+    if (frame.input(kDistance).empty()) {
+      latest_.update_missing(LatestMeasurement::Clock::now());
+      return;
+    }
     const auto& info = frame.info();
     // How old the frame already is, on the host clock the source stamped it with.
     std::chrono::milliseconds capture_age{0};
@@ -69,10 +77,6 @@ class ModbusOutput final : public Sink {
     }
     latest_.update(info.frame_id, frame.input<GroundDistance>(kDistance),
                    LatestMeasurement::Clock::now(), capture_age);
-  }
-
-  void skipped(const FrameInfo& /*info*/) override {
-    latest_.update_missing(LatestMeasurement::Clock::now());
   }
 
   void finish() override {
@@ -91,7 +95,12 @@ StageDescriptor describe() {
   StageDescriptor d;
   d.type = "modbus.output";
   d.summary = "hands the ground distance to a PLC over Modbus TCP (docs/modbus.md)";
-  d.inputs = {PortSpec::of<GroundDistance>("distance", "the measurement to publish")};
+  d.inputs = {
+      PortSpec::of<GroundDistance>("distance", "the measurement; a frame without one clears valid")
+          .optional(),
+      PortSpec::of<CameraStatus>("cameras", "the cameras' health, for the camera_ok bit")
+          .optional(),
+  };
   d.params = {
       ParamSpec::choice("mode", {"server", "client"}, "server")
           .describe("server: the PLC polls Tilth; client: Tilth writes into the PLC"),

@@ -106,6 +106,34 @@ TEST(GraphLoader, NodeWithTypeReplacesIncludedNode) {
   EXPECT_TRUE(graph.nodes[0].params.empty());
 }
 
+// An override file swaps the cameras of a machine graph for a simulator: null removes
+// an included node and its edges; the new node is wired in its place.
+TEST(GraphLoader, NullRemovesAnIncludedNodeWithItsEdges) {
+  TempDir dir;
+  dir.write("machine.json", R"({
+    "nodes": {"cam": {"type": "test.camera"}, "pair": {"type": "test.pair"},
+              "chain": {"type": "test.chain"}},
+    "edges": [["cam.image", "pair.image"], ["pair.image", "chain.in"]]
+  })");
+  const auto file = dir.write("g.json", R"({
+    "include": ["machine.json"],
+    "nodes": {"cam": null, "pair": null, "sim": {"type": "test.sim"}},
+    "edges": [["sim.raw", "chain.in"]]
+  })");
+  const GraphSpec graph = load_graph(file);
+  ASSERT_EQ(graph.nodes.size(), 2u);
+  EXPECT_EQ(graph.nodes[0].name, "chain");
+  EXPECT_EQ(graph.nodes[1].name, "sim");
+  ASSERT_EQ(graph.edges.size(), 1u);
+  EXPECT_EQ(graph.edges[0].from, "sim.raw");
+
+  const auto wrong =
+      dir.write("h.json", R"({"include": ["machine.json"], "nodes": {"cma": null}})");
+  EXPECT_EQ(load_error(wrong), wrong.string() +
+                                   ":/nodes/cma: null removes an included node, but there is no "
+                                   "node 'cma'; did you mean 'cam'?");
+}
+
 TEST(GraphLoader, CommandLineOverridesParamsVariablesAndRuntime) {
   TempDir dir;
   const auto file = dir.write("g.json", R"({

@@ -176,6 +176,27 @@ TEST_F(LatestMeasurementTest, AFrameWithoutMeasurementIsAPipelineError) {
   EXPECT_EQ(encode(values, WordOrder::kHighFirst)[kStatus], kValid | kCameraOk);
 }
 
+// A frame without a measurement clears valid at once, not only after the stale timeout.
+TEST_F(LatestMeasurementTest, AFrameWithoutMeasurementClearsValidAtOnce) {
+  latest_.update(1, measured(500.0, true), t0_, milliseconds(0));
+  latest_.update_missing(t0_ + milliseconds(33));
+  EXPECT_EQ(encode(latest_.values_at(t0_ + milliseconds(34)), WordOrder::kHighFirst)[kStatus],
+            kCameraOk | kPipelineError);
+}
+
+// A lost camera: frames still come (the cameras' status), without measurements; the PLC
+// sees camera_ok and valid clear, and no pipeline error, from the first such frame.
+TEST_F(LatestMeasurementTest, ALostCameraClearsCameraOkAndValid) {
+  latest_.update(1, measured(500.0, true), t0_, milliseconds(0));
+  latest_.update_cameras(false);
+  latest_.update_missing(t0_ + milliseconds(33));
+  EXPECT_EQ(encode(latest_.values_at(t0_ + milliseconds(34)), WordOrder::kHighFirst)[kStatus], 0);
+  latest_.update_cameras(true);
+  latest_.update(2, measured(501.0, true), t0_ + milliseconds(66), milliseconds(0));
+  EXPECT_EQ(encode(latest_.values_at(t0_ + milliseconds(67)), WordOrder::kHighFirst)[kStatus],
+            kValid | kCameraOk);
+}
+
 TEST_F(LatestMeasurementTest, TooLittleSoilIsTheInvalidReasonAboutSoil) {
   latest_.update(3, measured(0.0, false, "too little visible soil (2 %)"), t0_, milliseconds(0));
   EXPECT_EQ(encode(latest_.values_at(t0_), WordOrder::kHighFirst)[kStatus],
