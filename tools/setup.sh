@@ -19,6 +19,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # independent readers in tests
   python3-opencv python3-numpy
+  # tilth ab tests: statistics recomputed independently, the report opened in a browser
+  python3-scipy chromium
 )
 
 missing=()

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ground_truth_message.h"
 #include "mcap_reader.h"
 #include "raw_image.h"
 #include "recording_layout.h"
@@ -76,6 +77,9 @@ class McapPlayer final : public Source {
     if (!raw_channel_ || !color_channel_) {
       throw Error(reader_.file().string() + ": expected channels " + std::string(kRawTopic) +
                   " and " + std::string(kColorTopic) + " (an mcap.writer recording)");
+    }
+    for (const auto& image_channel : {raw_channel_, color_channel_, mask_channel_}) {
+      if (image_channel) check_image_channel(reader_.channels().at(*image_channel));
     }
     if (const auto& recovery = reader_.recovery()) {
       log_.warning(reader_.file().string() +
@@ -159,6 +163,17 @@ class McapPlayer final : public Source {
       } else if (channel == mask_channel_) {
         frame.mask = std::move(message);
       }
+    }
+  }
+
+  // Images are CDR-encoded RawImages; an older recording (JSON images) says so here,
+  // before the graph runs.
+  void check_image_channel(const Channel& channel) const {
+    if (channel.message_encoding != kCdrEncoding) {
+      throw Error(reader_.file().string() + ": channel " + channel.topic +
+                  " has message encoding '" + channel.message_encoding + "'; expected '" +
+                  std::string(kCdrEncoding) + "' (" + std::string(kRawImageSchemaName) +
+                  " as mcap.writer records it)");
     }
   }
 

@@ -61,9 +61,12 @@ RecordingInfo recording_info(const std::filesystem::path& file) {
   }
   for (const ChunkIndex& chunk : reader.chunks()) {
     const std::string name = chunk.compression.empty() ? "none" : chunk.compression;
-    if (std::find(info.compressions.begin(), info.compressions.end(), name) ==
-        info.compressions.end()) {
-      info.compressions.push_back(name);
+    const auto known = std::find_if(info.compressions.begin(), info.compressions.end(),
+                                    [&](const auto& entry) { return entry.first == name; });
+    if (known == info.compressions.end()) {
+      info.compressions.emplace_back(name, 1);
+    } else {
+      ++known->second;
     }
   }
   for (const AttachmentIndex& attachment : reader.attachments()) {
@@ -85,8 +88,9 @@ std::string format_info(const RecordingInfo& info) {
   text << "library:     " << info.library << "\n";
   text << "messages:    " << info.message_count << " in " << info.chunk_count << " chunks\n";
   std::string compressions;
-  for (const std::string& name : info.compressions) {
+  for (const auto& [name, chunks] : info.compressions) {
     compressions += (compressions.empty() ? "" : ", ") + name;
+    if (info.compressions.size() > 1) compressions += " (" + std::to_string(chunks) + " chunks)";
   }
   text << "compression: " << (compressions.empty() ? "-" : compressions) << "\n";
   text << "duration:    " << seconds_text(info.duration_s()) << " (log time " << info.start_time_ns

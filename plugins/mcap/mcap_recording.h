@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tilth::mcap {
@@ -29,7 +30,8 @@ struct RecordingInfo {
   std::uint64_t chunk_count = 0;
   std::uint64_t start_time_ns = 0;  // log times of the first and last message
   std::uint64_t end_time_ns = 0;
-  std::vector<std::string> compressions;  // of the chunks, each once
+  // How many chunks each compression holds ("none" for stored chunks), in first-seen order.
+  std::vector<std::pair<std::string, std::uint64_t>> compressions;
   std::vector<std::string> attachments;
   std::vector<std::string> metadata;
 

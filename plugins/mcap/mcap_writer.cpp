@@ -1,6 +1,10 @@
 #include "mcap_writer.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 
 #include "compression.h"
 #include "crc32.h"
@@ -17,6 +21,15 @@ std::string record_prefix(Opcode opcode, std::uint64_t content_size) {
   RecordBuilder prefix;
   prefix.u8(static_cast<std::uint8_t>(opcode)).u64(content_size);
   return prefix.content();
+}
+
+// Compression is best effort, recording is not: a compression thread yields the CPU to
+// the thread that adds messages (and so to the cameras' frames), which stores the chunks
+// it could not compress in time (store_when_behind). Linux gives each thread its nice
+// value.
+void lower_this_thread_priority() {
+  constexpr int kCompressionNice = 10;
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kCompressionNice);
 }
 
 std::string summary_offset(Opcode group, std::uint64_t start, std::uint64_t length) {
@@ -51,7 +64,6 @@ void McapWriter::put(std::string_view bytes) {
   out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!out_) throw Error(file_.string() + ": cannot write at offset " + std::to_string(offset_));
   offset_ += bytes.size();
-  data_crc_ = crc32(bytes, data_crc_);
 }
 
 std::uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding,
@@ -131,6 +143,13 @@ void McapWriter::close_chunk_if_full() {
   if (chunk_records_.size() >= options_.chunk_size) close_chunk();
 }
 
+std::size_t McapWriter::compressing() const {
+  return static_cast<std::size_t>(std::count_if(closed_.begin(), closed_.end(), [](const auto& c) {
+    return !c.compression.empty() &&
+           c.data.wait_for(std::chrono::seconds(0)) == std::future_status::timeout;
+  }));
+}
+
 void McapWriter::close_chunk() {
   if (!chunk_records_.empty()) {
     ClosedChunk chunk;
@@ -138,47 +157,62 @@ void McapWriter::close_chunk() {
     chunk.end_time = chunk_end_time_;
     chunk.uncompressed_size = chunk_records_.size();
     chunk.index = std::move(chunk_index_);
-    chunk.compressed = std::async(std::launch::async, [compression = options_.compression,
-                                                       records = std::move(chunk_records_)] {
-      return std::pair{compress(compression, records), crc32(records)};
-    });
+    const bool behind = options_.store_when_behind && compressing() >= options_.chunks_in_flight;
+    chunk.compression = behind ? "" : options_.compression;
+    // Stored chunks are deferred: their CRC is computed when they are written.
+    chunk.data = std::async(
+        chunk.compression.empty() ? std::launch::deferred : std::launch::async,
+        [compression = chunk.compression, records = std::move(chunk_records_)]() mutable {
+          if (!compression.empty()) lower_this_thread_priority();
+          const std::uint32_t crc = crc32(records);
+          return ChunkData{
+              compression.empty() ? std::move(records) : compress(compression, records), crc};
+        });
     closed_.push_back(std::move(chunk));
     chunk_records_.clear();
     chunk_index_.clear();
   }
-  while (closed_.size() > options_.chunks_in_flight) {
-    write_chunk(closed_.front());
-    closed_.pop_front();
+  const std::size_t limit =
+      options_.store_when_behind ? options_.max_queued_chunks : options_.chunks_in_flight;
+  while (!closed_.empty() &&
+         (closed_.size() > limit ||
+          closed_.front().data.wait_for(std::chrono::seconds(0)) != std::future_status::timeout)) {
+    write_oldest_chunk();
   }
 }
 
 void McapWriter::flush() {
   close_chunk();
-  while (!closed_.empty()) {
-    write_chunk(closed_.front());
-    closed_.pop_front();
-  }
+  while (!closed_.empty()) write_oldest_chunk();
+}
+
+void McapWriter::write_oldest_chunk() {
+  write_chunk(closed_.front());
+  closed_.pop_front();
 }
 
 McapWriter::~McapWriter() {
-  for (ClosedChunk& chunk : closed_) chunk.compressed.wait();
+  for (ClosedChunk& chunk : closed_) {
+    if (!chunk.compression.empty()) chunk.data.wait();
+  }
 }
 
 void McapWriter::write_chunk(ClosedChunk& chunk) {
-  const auto [compressed, crc] = chunk.compressed.get();
+  const ChunkData data = chunk.data.get();
+  const std::string& compressed = data.bytes;
   RecordBuilder head;
   head.u64(chunk.start_time)
       .u64(chunk.end_time)
       .u64(chunk.uncompressed_size)
-      .u32(crc)
-      .string(options_.compression)
+      .u32(data.uncompressed_crc)
+      .string(chunk.compression)
       .u64(compressed.size());
 
   ChunkIndex index;
   index.message_start_time = chunk.start_time;
   index.message_end_time = chunk.end_time;
   index.chunk_start_offset = offset_;
-  index.compression = options_.compression;
+  index.compression = chunk.compression;
   index.compressed_size = compressed.size();
   index.uncompressed_size = chunk.uncompressed_size;
   put(record_prefix(Opcode::kChunk, head.content().size() + compressed.size()));
@@ -205,7 +239,9 @@ void McapWriter::write_chunk(ClosedChunk& chunk) {
 void McapWriter::finish() {
   check_open("finish");
   flush();
-  put(RecordBuilder().u32(data_crc_).record(Opcode::kDataEnd));
+  // data_section_crc 0: not computed. It would be a pass over every byte on the
+  // recording's thread; chunks, attachments and the summary carry CRCs of their own.
+  put(RecordBuilder().u32(0).record(Opcode::kDataEnd));
 
   // The summary is built in memory: its CRC covers it up to the Footer's offsets.
   const std::uint64_t summary_start = offset_;

@@ -1,8 +1,8 @@
 // Writes an MCAP file: Header, then schemas, channels, attachments and metadata as they
 // are added, messages in compressed chunks each followed by its MessageIndex records,
 // and on finish() DataEnd, the summary section, SummaryOffset records and the Footer.
-// Closed chunks are compressed on background threads (compressing a 30 frame/s stream
-// of base64 images takes more than one core) and written, in order, as they complete;
+// Closed chunks are compressed (and their CRC computed) on background threads, off the
+// thread that adds messages, and written, in order, as they complete;
 // each is flushed to the file when written, so a process killed mid-write leaves a file
 // that is readable up to its last written chunk.
 #pragma once
@@ -24,8 +24,15 @@ struct WriterOptions {
   std::string compression = std::string(kZstd);  // "zstd", "lz4" or "" (none)
   // A chunk is closed by close_chunk_if_full() once it holds this many bytes.
   std::uint64_t chunk_size = 4 * 1024 * 1024;
-  // Closed chunks being compressed at once; close_chunk() waits for the oldest beyond.
+  // Closed chunks compressed at once, each on a thread of its own.
   std::size_t chunks_in_flight = 2;
+  // false: close_chunk() waits while more than chunks_in_flight closed chunks are not
+  // yet written. true (a live recording): a chunk closed while chunks_in_flight others
+  // are still being compressed is stored uncompressed instead, so the recording keeps
+  // up with its cameras when the CPU cannot compress everything; close_chunk() waits
+  // only while more than max_queued_chunks are not yet written.
+  bool store_when_behind = false;
+  std::size_t max_queued_chunks = 8;
   std::string profile;  // the Header's profile; "" = none of the well-known ones
   std::string library = "tilth";
 };
@@ -55,9 +62,9 @@ class McapWriter {
   // Closes the open chunk when it has reached chunk_size: call between messages that
   // belong in one chunk (a frame's images).
   void close_chunk_if_full();
-  // Hands the open chunk, if it has messages, to a background compression; writes the
-  // chunks whose compression is done, oldest first, while more than chunks_in_flight
-  // are pending.
+  // Hands the open chunk, if it has messages, to a background compression (or, behind,
+  // stores it uncompressed; see WriterOptions); writes the closed chunks that are ready,
+  // oldest first, and waits for the oldest while too many are queued.
   void close_chunk();
   // Closes the open chunk and writes every pending one with its MessageIndex records.
   void flush();
@@ -68,17 +75,17 @@ class McapWriter {
   std::uint64_t bytes_written() const { return offset_; }
 
  private:
-  // Writes to the file, counting the offset and the data section's CRC.
+  // Writes to the file, counting the offset.
   void put(std::string_view bytes);
   void check_open(std::string_view what) const;
   struct ClosedChunk;
   void write_chunk(ClosedChunk& chunk);
+  void write_oldest_chunk();
 
   const std::filesystem::path file_;
   const WriterOptions options_;
   std::ofstream out_;
   std::uint64_t offset_ = 0;
-  std::uint32_t data_crc_ = 0;
   bool finished_ = false;
 
   std::vector<Schema> schemas_;
@@ -97,14 +104,21 @@ class McapWriter {
       std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>>;
   MessageOffsets chunk_index_;
 
-  // A chunk closed and being compressed.
+  // A chunk closed and not yet written: its records compressed (on a thread of its own),
+  // or stored as they are (when written), and their CRC.
+  struct ChunkData {
+    std::string bytes;
+    std::uint32_t uncompressed_crc = 0;
+  };
   struct ClosedChunk {
     std::uint64_t start_time = 0;
     std::uint64_t end_time = 0;
     std::uint64_t uncompressed_size = 0;
+    std::string compression;
     MessageOffsets index;
-    std::future<std::pair<std::string, std::uint32_t>> compressed;  // data, uncompressed CRC
+    std::future<ChunkData> data;
   };
+  std::size_t compressing() const;
   std::deque<ClosedChunk> closed_;
 };
 

@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "ground_truth_message.h"
 #include "mcap_writer.h"
 #include "raw_image.h"
 #include "recording_layout.h"
@@ -67,6 +68,7 @@ WriterOptions writer_options(const Params& params) {
   const std::string compression = params.string("compression");
   options.compression = compression == "none" ? "" : compression;
   options.chunk_size = static_cast<std::uint64_t>(params.integer("chunk_size"));
+  options.store_when_behind = params.string("when_behind") == "store";
   return options;
 }
 
@@ -92,16 +94,17 @@ class McapWriterStage final : public Sink {
     }
     writer_.add_metadata({std::string(kRecordingMetadata), recording});
 
-    const std::string json_schema(kJsonSchemaEncoding);
-    const std::string json(kJsonEncoding);
-    const std::uint16_t image =
-        writer_.add_schema(std::string(kRawImageSchemaName), json_schema, raw_image_schema());
+    const std::string cdr(kCdrEncoding);
+    const std::uint16_t image = writer_.add_schema(
+        std::string(kRawImageSchemaName), std::string(kRos2MsgSchemaEncoding), raw_image_schema());
     const std::uint16_t truth =
-        writer_.add_schema(std::string(kGroundTruthSchemaName), json_schema, ground_truth_schema());
-    raw_channel_ = writer_.add_channel(image, std::string(kRawTopic), json);
-    color_channel_ = writer_.add_channel(image, std::string(kColorTopic), json);
-    truth_channel_ = writer_.add_channel(truth, std::string(kTruthTopic), json);
-    mask_channel_ = writer_.add_channel(image, std::string(kMaskTopic), json);
+        writer_.add_schema(std::string(kGroundTruthSchemaName), std::string(kJsonSchemaEncoding),
+                           ground_truth_schema());
+    raw_channel_ = writer_.add_channel(image, std::string(kRawTopic), cdr);
+    color_channel_ = writer_.add_channel(image, std::string(kColorTopic), cdr);
+    truth_channel_ =
+        writer_.add_channel(truth, std::string(kTruthTopic), std::string(kJsonEncoding));
+    mask_channel_ = writer_.add_channel(image, std::string(kMaskTopic), cdr);
   }
 
   void consume(const Frame& frame) override {
@@ -109,6 +112,8 @@ class McapWriterStage final : public Sink {
     const auto& color = frame.input<ColorImage>(kColorPort);
     const Packet& truth_packet = frame.input(kTruthPort);
     const GroundTruth* truth = truth_packet.empty() ? nullptr : &truth_packet.get<GroundTruth>();
+    // A truth that knows nothing (a replayed recording without any) is not recorded.
+    if (truth != nullptr && !truth->distance_mm && truth->residue_mask.empty()) truth = nullptr;
 
     const std::uint64_t frame_id = frame.info().frame_id;
     if (frame_id > std::numeric_limits<std::uint32_t>::max()) {
@@ -168,6 +173,9 @@ StageDescriptor describe() {
           .describe("the MCAP file to create (replaced if it exists)"),
       ParamSpec::choice("compression", {"zstd", "lz4", "none"}, "zstd")
           .describe("chunk compression"),
+      ParamSpec::choice("when_behind", {"store", "wait"}, "store")
+          .describe("a chunk closed while two others are still being compressed: store it "
+                    "uncompressed (the recording keeps up with the cameras) or wait for them"),
       ParamSpec::integer("chunk_size", 4 * 1024 * 1024)
           .range(1, std::nullopt)
           .in_unit("bytes")

@@ -1,39 +1,96 @@
-// The image JSON is written by hand, not through nlohmann::json: the base64 data is
-// most of a frame's bytes and is appended once, in place.
+// CDR as ROS 2 writes it (XCDR1, little-endian): a 4-byte encapsulation header, then
+// each field aligned to its own size counted from the end of the header; a string is a
+// uint32 length that includes a terminating NUL, then the bytes and the NUL; uint8[] is a
+// uint32 count, then the bytes.
 #include "raw_image.h"
 
-#include <nlohmann/json.hpp>
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <optional>
 
-#include "base64.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {
 namespace {
 
-using nlohmann::json;
+static_assert(std::endian::native == std::endian::little, "CDR is written little-endian");
 
-json time_schema() {
-  return {{"type", "object"},
-          {"title", "time"},
-          {"properties",
-           {{"sec", {{"type", "integer"}, {"minimum", 0}}},
-            {"nsec", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999999}}}}}};
-}
+constexpr std::string_view kLittleEndianCdr("\x00\x01\x00\x00", 4);
+constexpr std::size_t kHeaderSize = kLittleEndianCdr.size();
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 
-std::string timestamp_json(std::int64_t timestamp_ns) {
-  return R"({"sec":)" + std::to_string(timestamp_ns / 1'000'000'000) + R"(,"nsec":)" +
-         std::to_string(timestamp_ns % 1'000'000'000) + "}";
-}
-
-std::int64_t timestamp_of(const json& message, const std::string& where) {
-  const json& time = message.at("timestamp");
-  const std::int64_t sec = time.at("sec").get<std::int64_t>();
-  const std::int64_t nsec = time.at("nsec").get<std::int64_t>();
-  if (sec < 0 || nsec < 0 || nsec > 999'999'999) {
-    throw Error(where + ": /timestamp: expected sec >= 0 and nsec in [0, 999999999]");
+class CdrWriter {
+ public:
+  explicit CdrWriter(std::size_t reserve) {
+    out_.reserve(reserve);
+    out_ += kLittleEndianCdr;
   }
-  return sec * 1'000'000'000 + nsec;
-}
+  void u32(std::uint32_t value) { put(value); }
+  void i32(std::int32_t value) { put(value); }
+  void string(std::string_view text) {
+    u32(static_cast<std::uint32_t>(text.size() + 1));
+    out_ += text;
+    out_ += '\0';
+  }
+  void bytes(std::string_view data) {
+    u32(static_cast<std::uint32_t>(data.size()));
+    out_ += data;
+  }
+  std::string take() { return std::move(out_); }
+
+ private:
+  template <class T>
+  void put(T value) {
+    out_.append((sizeof(T) - (out_.size() - kHeaderSize) % sizeof(T)) % sizeof(T), '\0');
+    out_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  std::string out_;
+};
+
+class CdrReader {
+ public:
+  CdrReader(std::string_view data, const std::string& where) : data_(data), where_(where) {
+    if (data_.substr(0, kHeaderSize) != kLittleEndianCdr) {
+      throw Error(where_ + ": expected a little-endian CDR message (header 00 01 00 00)");
+    }
+    position_ = kHeaderSize;
+  }
+  std::uint32_t u32(std::string_view field) { return get<std::uint32_t>(field); }
+  std::int32_t i32(std::string_view field) { return get<std::int32_t>(field); }
+  std::string string(std::string_view field) {
+    const std::uint32_t size = u32(field);
+    const std::string_view text = take(size, field);
+    if (size == 0 || text.back() != '\0') {
+      throw Error(where_ + ": " + std::string(field) + ": expected a NUL-terminated string");
+    }
+    return std::string(text.substr(0, size - 1));
+  }
+  std::string_view bytes(std::string_view field) { return take(u32(field), field); }
+
+ private:
+  template <class T>
+  T get(std::string_view field) {
+    position_ += (sizeof(T) - (position_ - kHeaderSize) % sizeof(T)) % sizeof(T);
+    T value{};
+    std::memcpy(&value, take(sizeof(T), field).data(), sizeof(T));
+    return value;
+  }
+  std::string_view take(std::size_t size, std::string_view field) {
+    if (size > data_.size() - std::min(position_, data_.size())) {
+      throw Error(where_ + ": " + std::string(field) + ": " + std::to_string(size) +
+                  " bytes at offset " + std::to_string(position_) + " run past the message's " +
+                  std::to_string(data_.size()) + " bytes");
+    }
+    const std::string_view bytes = data_.substr(position_, size);
+    position_ += size;
+    return bytes;
+  }
+
+  std::string_view data_;
+  const std::string& where_;
+  std::size_t position_ = 0;
+};
 
 // OpenCV type and bytes per pixel of a Foxglove encoding Tilth records.
 std::optional<std::pair<int, int>> pixel_type(std::string_view encoding) {
@@ -43,117 +100,77 @@ std::optional<std::pair<int, int>> pixel_type(std::string_view encoding) {
   return std::nullopt;
 }
 
-json parse(std::string_view text, const std::string& where) {
-  json message = json::parse(text, nullptr, false);
-  if (message.is_discarded() || !message.is_object()) {
-    throw Error(where + ": message data is not a JSON object");
-  }
-  return message;
-}
-
 }  // namespace
 
 std::string raw_image_schema() {
-  const json schema = {{"title", "foxglove.RawImage"},
-                       {"description", "A raw image"},
-                       {"$comment", "Generated by Tilth to match Foxglove's schema"},
-                       {"type", "object"},
-                       {"properties",
-                        {{"timestamp", time_schema()},
-                         {"frame_id", {{"type", "string"}}},
-                         {"width", {{"type", "integer"}, {"minimum", 0}}},
-                         {"height", {{"type", "integer"}, {"minimum", 0}}},
-                         {"encoding", {{"type", "string"}}},
-                         {"step", {{"type", "integer"}, {"minimum", 0}}},
-                         {"data", {{"type", "string"}, {"contentEncoding", "base64"}}}}}};
-  return schema.dump();
-}
-
-std::string ground_truth_schema() {
-  const json schema = {
-      {"title", "tilth.GroundTruth"},
-      {"description",
-       "What is known to be true about a frame: the mounting surface to soil distance "
-       "(null when unknown); the residue mask, when known, is on /truth/mask"},
-      {"type", "object"},
-      {"properties",
-       {{"timestamp", time_schema()},
-        {"frame_id", {{"type", "string"}}},
-        {"distance_mm", {{"type", {"number", "null"}}}},
-        {"has_mask", {{"type", "boolean"}}}}}};
-  return schema.dump();
+  return "# foxglove_msgs/msg/RawImage: a raw image (https://docs.foxglove.dev)\n"
+         "builtin_interfaces/Time timestamp\n"
+         "string frame_id\n"
+         "uint32 width\n"
+         "uint32 height\n"
+         "string encoding\n"
+         "uint32 step\n"
+         "uint8[] data\n"
+         "================================================================================\n"
+         "MSG: builtin_interfaces/Time\n"
+         "int32 sec\n"
+         "uint32 nanosec\n";
 }
 
 std::string encode_raw_image(const cv::Mat& image, std::string_view encoding,
                              std::int64_t timestamp_ns, std::string_view frame_id) {
   const cv::Mat pixels = image.isContinuous() ? image : image.clone();
   const std::size_t step = pixels.cols * pixels.elemSize();
-  const std::string_view bytes(reinterpret_cast<const char*>(pixels.data), step * pixels.rows);
-  std::string out;
-  out.reserve(bytes.size() / 3 * 4 + 256);
-  out += R"({"timestamp":)" + timestamp_json(timestamp_ns);
-  out += R"(,"frame_id":")" + std::string(frame_id) + '"';
-  out += R"(,"width":)" + std::to_string(pixels.cols);
-  out += R"(,"height":)" + std::to_string(pixels.rows);
-  out += R"(,"encoding":")" + std::string(encoding) + '"';
-  out += R"(,"step":)" + std::to_string(step);
-  out += R"(,"data":")";
-  append_base64(out, bytes);
-  out += "\"}";
-  return out;
-}
-
-RawImage decode_raw_image(std::string_view text, const std::string& where) {
-  const json message = parse(text, where);
-  try {
-    RawImage image;
-    image.encoding = message.at("encoding").get<std::string>();
-    image.timestamp_ns = timestamp_of(message, where);
-    const auto type = pixel_type(image.encoding);
-    if (!type) {
-      throw Error(where + ": /encoding: '" + image.encoding +
-                  "' is not recorded by Tilth; expected mono16, mono8, bgr8, rgb8 or bayer_*8");
-    }
-    const int width = message.at("width").get<int>();
-    const int height = message.at("height").get<int>();
-    const std::size_t step = message.at("step").get<std::size_t>();
-    const std::string data =
-        decode_base64(message.at("data").get_ref<const std::string&>(), where + ": /data");
-    if (width <= 0 || height <= 0 || step < static_cast<std::size_t>(width) * type->second ||
-        data.size() != step * static_cast<std::size_t>(height)) {
-      throw Error(where + ": expected " + std::to_string(height) + " rows of step " +
-                  std::to_string(step) + " >= width x " + std::to_string(type->second) +
-                  " bytes, got " + std::to_string(data.size()) + " data bytes");
-    }
-    cv::Mat wrapped(height, width, type->first, const_cast<char*>(data.data()), step);
-    image.pixels = wrapped.clone();
-    return image;
-  } catch (const json::exception& error) {
-    throw Error(where + ": not a foxglove.RawImage: " + error.what());
+  const std::string_view data(reinterpret_cast<const char*>(pixels.data), step * pixels.rows);
+  if (timestamp_ns < 0 || timestamp_ns / kNsPerSecond > std::numeric_limits<std::int32_t>::max()) {
+    throw Error("timestamp " + std::to_string(timestamp_ns) +
+                " ns: expected 0 to 2^31 s (a ROS 2 time has int32 seconds)");
   }
+  CdrWriter cdr(data.size() + 64 + frame_id.size() + encoding.size());
+  cdr.i32(static_cast<std::int32_t>(timestamp_ns / kNsPerSecond));
+  cdr.u32(static_cast<std::uint32_t>(timestamp_ns % kNsPerSecond));
+  cdr.string(frame_id);
+  cdr.u32(static_cast<std::uint32_t>(pixels.cols));
+  cdr.u32(static_cast<std::uint32_t>(pixels.rows));
+  cdr.string(encoding);
+  cdr.u32(static_cast<std::uint32_t>(step));
+  cdr.bytes(data);
+  return cdr.take();
 }
 
-std::string encode_ground_truth(std::optional<double> distance_mm, bool has_mask,
-                                std::int64_t timestamp_ns) {
-  json message = {{"timestamp", json::parse(timestamp_json(timestamp_ns))},
-                  {"frame_id", "tof"},
-                  {"distance_mm", nullptr},
-                  {"has_mask", has_mask}};
-  if (distance_mm) message["distance_mm"] = *distance_mm;
-  return message.dump();
-}
-
-GroundTruthMessage decode_ground_truth(std::string_view text, const std::string& where) {
-  const json message = parse(text, where);
-  try {
-    GroundTruthMessage truth;
-    const json& distance = message.at("distance_mm");
-    if (!distance.is_null()) truth.distance_mm = distance.get<double>();
-    truth.has_mask = message.at("has_mask").get<bool>();
-    return truth;
-  } catch (const json::exception& error) {
-    throw Error(where + ": not a tilth.GroundTruth: " + error.what());
+RawImage decode_raw_image(std::string_view message, const std::string& where) {
+  CdrReader cdr(message, where);
+  RawImage image;
+  const std::int32_t sec = cdr.i32("timestamp.sec");
+  const std::uint32_t nanosec = cdr.u32("timestamp.nanosec");
+  if (sec < 0 || nanosec >= kNsPerSecond) {
+    throw Error(where + ": timestamp: expected sec >= 0 and nanosec in [0, 999999999], got " +
+                std::to_string(sec) + " and " + std::to_string(nanosec));
   }
+  image.timestamp_ns = sec * kNsPerSecond + nanosec;
+  image.frame_id = cdr.string("frame_id");
+  const std::uint32_t width = cdr.u32("width");
+  const std::uint32_t height = cdr.u32("height");
+  image.encoding = cdr.string("encoding");
+  const std::uint32_t step = cdr.u32("step");
+  const std::string_view data = cdr.bytes("data");
+  const auto type = pixel_type(image.encoding);
+  if (!type) {
+    throw Error(where + ": encoding: '" + image.encoding +
+                "' is not recorded by Tilth; expected mono16, mono8, bgr8, rgb8 or bayer_*8");
+  }
+  if (width == 0 || height == 0 || width > 65535 || height > 65535 ||
+      step < static_cast<std::size_t>(width) * type->second ||
+      data.size() != static_cast<std::size_t>(step) * height) {
+    throw Error(where + ": expected " + std::to_string(height) + " rows of step " +
+                std::to_string(step) + " >= width " + std::to_string(width) + " x " +
+                std::to_string(type->second) + " bytes, got " + std::to_string(data.size()) +
+                " data bytes");
+  }
+  const cv::Mat wrapped(static_cast<int>(height), static_cast<int>(width), type->first,
+                        const_cast<char*>(data.data()), step);
+  image.pixels = wrapped.clone();
+  return image;
 }
 
 }  // namespace tilth::mcap

@@ -6,10 +6,10 @@
 
 namespace tilth::mcap {
 
-inline constexpr std::string_view kRawTopic = "/tof/raw";        // foxglove.RawImage mono16
+inline constexpr std::string_view kRawTopic = "/tof/raw";        // RawImage mono16
 inline constexpr std::string_view kColorTopic = "/color/image";  // bgr8, rgb8 or bayer_*8
 inline constexpr std::string_view kTruthTopic = "/truth";        // tilth.GroundTruth
-inline constexpr std::string_view kMaskTopic = "/truth/mask";    // foxglove.RawImage mono8
+inline constexpr std::string_view kMaskTopic = "/truth/mask";    // RawImage mono8
 
 inline constexpr std::string_view kCalibrationAttachment = "rig.calib.json";
 inline constexpr std::string_view kCalibrationMetadata = "tilth.calibration";  // key "json"

@@ -6,6 +6,7 @@
 #include "mcap_fixture.h"
 #include "mcap_reader.h"
 #include "mcap_recording.h"
+#include "mcap_writer.h"
 
 namespace tilth::testing {
 namespace {
@@ -87,7 +88,7 @@ TEST_F(McapRecoveryTest, RepairInPlaceAndInfoOfACutFile) {
   EXPECT_FALSE(before.has_summary);
   EXPECT_EQ(before.readable_bytes, chunks_[3].chunk_start_offset);
   EXPECT_EQ(before.chunk_count, 3u);
-  EXPECT_EQ(before.message_count, 3u + 3u + 3u + 2u);
+  EXPECT_EQ(before.message_count, 4u + 2u + 4u);  // frames without truth have no /truth
   EXPECT_NE(mcap::format_info(before).find("summary:     MISSING"), std::string::npos);
 
   const mcap::RepairResult result = mcap::repair_recording(file, file);
@@ -131,6 +132,31 @@ TEST_F(McapRecoveryTest, NotAnMcapFileFailsBeforeTheGraphRuns) {
                                                json::array({"src.color", "out.color"})})}})
                       .dump());
   EXPECT_NE(error.find("not an MCAP file"), std::string::npos) << error;
+}
+
+TEST_F(McapRecoveryTest, ImagesInAnotherEncodingFailBeforeTheGraphRuns) {
+  const fs::path file = dir_.path() / "json-images.mcap";
+  {
+    mcap::McapWriter writer(file, {});
+    writer.add_attachment(
+        {0, 0, "rig.calib.json", "application/json", read_text(calibration_file_)});
+    const std::uint16_t schema = writer.add_schema("foxglove.RawImage", "jsonschema", "{}");
+    writer.add_channel(schema, "/tof/raw", "json");
+    writer.add_channel(schema, "/color/image", "json");
+    writer.finish();
+  }
+  const std::string error =
+      start_error(json({{"nodes",
+                         {{"src", {{"type", "mcap.player"}, {"params", {{"path", file.string()}}}}},
+                          {"out", {{"type", "test.capture"}}}}},
+                        {"edges", json::array({json::array({"src.raw", "out.raw"}),
+                                               json::array({"src.color", "out.color"})})}})
+                      .dump());
+  EXPECT_NE(
+      error.find(file.string() + ": channel /tof/raw has message encoding 'json'; expected 'cdr' "
+                                 "(foxglove_msgs/msg/RawImage as mcap.writer records it)"),
+      std::string::npos)
+      << error;
 }
 
 }  // namespace

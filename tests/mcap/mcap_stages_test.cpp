@@ -62,14 +62,21 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   ASSERT_TRUE(reader.statistics());
   std::map<std::string, std::uint64_t> counts;
   for (const auto& [id, channel] : reader.channels()) {
-    EXPECT_EQ(channel.message_encoding, "json");
     const mcap::Schema& schema = reader.schemas().at(channel.schema_id);
-    EXPECT_EQ(schema.encoding, "jsonschema");
-    EXPECT_EQ(schema.name, channel.topic == "/truth" ? "tilth.GroundTruth" : "foxglove.RawImage");
+    if (channel.topic == "/truth") {
+      EXPECT_EQ(channel.message_encoding, "json");
+      EXPECT_EQ(schema.encoding, "jsonschema");
+      EXPECT_EQ(schema.name, "tilth.GroundTruth");
+    } else {
+      EXPECT_EQ(channel.message_encoding, "cdr");
+      EXPECT_EQ(schema.encoding, "ros2msg");
+      EXPECT_EQ(schema.name, "foxglove_msgs/msg/RawImage");
+    }
     counts[channel.topic] = reader.statistics()->channel_message_counts.at(id);
   }
+  // Frames without truth (every second one) have no /truth message.
   const std::map<std::string, std::uint64_t> expected_counts{
-      {"/tof/raw", 4}, {"/color/image", 4}, {"/truth", 4}, {"/truth/mask", 2}};
+      {"/tof/raw", 4}, {"/color/image", 4}, {"/truth", 2}, {"/truth/mask", 2}};
   EXPECT_EQ(counts, expected_counts);
   EXPECT_EQ(reader.chunks().size(), 4u);  // chunk_size 1: one frame per chunk
   EXPECT_EQ(reader.statistics()->message_start_time, 1'000'000'000u);
@@ -81,30 +88,45 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("json"),
             read_text(calibration_file_));
 
-  // The first colour message, as Foxglove reads it.
+  // The first colour message: a RawImage in CDR, byte by byte where it is not pixels.
   const std::vector<mcap::Message> messages = reader.read_chunk(reader.chunks().front());
   ASSERT_EQ(messages.size(), 4u);  // raw, color, truth, mask
-  const json color = json::parse(messages[1].data);
-  EXPECT_EQ(color["encoding"], "bgr8");
-  EXPECT_EQ(color["width"], 40);
-  EXPECT_EQ(color["height"], 30);
-  EXPECT_EQ(color["step"], 120);
-  EXPECT_EQ(color["frame_id"], "color");
-  EXPECT_EQ(color["timestamp"], json({{"sec", 1}, {"nsec", 400000}}));
+  const std::string& cdr = messages[1].data;
+  const std::string head(
+      "\x00\x01\x00\x00"                  // CDR, little-endian
+      "\x01\x00\x00\x00\x80\x1a\x06\x00"  // timestamp 1 s 400000 ns
+      "\x06\x00\x00\x00"
+      "color\x00"                         // frame_id, NUL-terminated
+      "\x00\x00"                          // aligned to 4
+      "\x28\x00\x00\x00\x1e\x00\x00\x00"  // width 40, height 30
+      "\x05\x00\x00\x00"
+      "bgr8\x00"
+      "\x00\x00\x00"
+      "\x78\x00\x00\x00"   // step 120
+      "\x10\x0e\x00\x00",  // 3600 data bytes
+      52);
+  ASSERT_EQ(cdr.size(), head.size() + 3600);
+  EXPECT_EQ(cdr.substr(0, head.size()), head);
+  EXPECT_EQ(cdr.substr(head.size()),
+            std::string(reinterpret_cast<const char*>(frames_[0].color.data), 3600));
   EXPECT_EQ(messages[1].sequence, 3u);
   EXPECT_EQ(messages[1].log_time, 1'000'400'000u);
   EXPECT_EQ(messages[1].publish_time, 1'000'400'000u);
-  EXPECT_TRUE(
-      same_pixels(frames_[0].color, mcap::decode_raw_image(messages[1].data, "test").pixels));
+  const mcap::RawImage color = mcap::decode_raw_image(cdr, "test");
+  EXPECT_EQ(color.encoding, "bgr8");
+  EXPECT_EQ(color.frame_id, "color");
+  EXPECT_EQ(color.timestamp_ns, 1'000'400'000);
+  EXPECT_TRUE(same_pixels(frames_[0].color, color.pixels));
   EXPECT_EQ(json::parse(messages[2].data)["distance_mm"], 500.0);
 
   const mcap::RecordingInfo info = mcap::recording_info(file);
   EXPECT_TRUE(info.has_summary);
-  EXPECT_EQ(info.message_count, 14u);
+  EXPECT_EQ(info.message_count, 12u);
   EXPECT_EQ(info.chunk_count, 4u);
   EXPECT_DOUBLE_EQ(info.duration_s(), 0.3004);
-  EXPECT_NE(mcap::format_info(info).find("/truth/mask  2 messages  foxglove.RawImage (json)"),
-            std::string::npos)
+  EXPECT_NE(
+      mcap::format_info(info).find("/truth/mask  2 messages  foxglove_msgs/msg/RawImage (cdr)"),
+      std::string::npos)
       << mcap::format_info(info);
 }
 
@@ -145,12 +167,13 @@ double process_cpu_seconds() {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
-// 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them. The
-// writer compresses on background threads, so what decides whether it keeps up is its
-// CPU time: at 30 frame pairs/s two free cores give 66 ms per pair. Measured 55-65 ms
-// (zstd level 1, this test's process including the feed); the check is a regression
-// guard above that. Wall time is printed too: on cores shared with other work it is
-// lower than what a free machine reaches.
+// 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them, every
+// chunk compressed (when_behind: wait). At 30 frame pairs/s a pair may take 33 ms of one
+// core; the writer takes 17-25 ms here (zstd level 1 ~12, the chunk CRC ~3.5, the rest
+// copies and writes, more on a loaded machine; bench/mcap has each part and the live
+// case). The check, 40 ms, catches a regression such as the 55-65 ms of base64 JSON
+// images. Wall time is printed too: on cores shared with other work it is lower than
+// what a free machine reaches.
 TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
 #if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "throughput is measured without sanitizers";
@@ -171,7 +194,8 @@ TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
   const double cpu_start = process_cpu_seconds();
   const auto start = std::chrono::steady_clock::now();
   const RunResult recorded =
-      record(file, PixelFormat::kBgr8, {{"calibration", shipped_calibration_file()}});
+      record(file, PixelFormat::kBgr8,
+             {{"calibration", shipped_calibration_file()}, {"when_behind", "wait"}});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double cpu_ms_per_pair = (process_cpu_seconds() - cpu_start) * 1e3 / count;
@@ -184,7 +208,9 @@ TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
       count, seconds, frames_per_second, cpu_ms_per_pair, megabytes);
   RecordProperty("frame_pairs_per_second", std::to_string(frames_per_second));
   RecordProperty("cpu_ms_per_frame_pair", std::to_string(cpu_ms_per_pair));
-  EXPECT_LT(cpu_ms_per_pair, 80.0);
+  EXPECT_LT(cpu_ms_per_pair, 40.0);
+  EXPECT_EQ(mcap::recording_info(file).compressions,
+            (std::vector<std::pair<std::string, std::uint64_t>>{{"zstd", count}}));
 }
 
 }  // namespace

@@ -1,0 +1,66 @@
+#include "ground_truth_message.h"
+
+#include <nlohmann/json.hpp>
+
+#include "tilth/error.h"
+
+namespace tilth::mcap {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+
+json time_schema() {
+  return {{"type", "object"},
+          {"title", "time"},
+          {"properties",
+           {{"sec", {{"type", "integer"}, {"minimum", 0}}},
+            {"nsec", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999999}}}}}};
+}
+
+}  // namespace
+
+std::string ground_truth_schema() {
+  const json schema = {
+      {"title", "tilth.GroundTruth"},
+      {"description",
+       "What is known to be true about a frame: the mounting surface to soil distance "
+       "(null when unknown); the residue mask, when known, is on /truth/mask"},
+      {"type", "object"},
+      {"properties",
+       {{"timestamp", time_schema()},
+        {"frame_id", {{"type", "string"}}},
+        {"distance_mm", {{"type", {"number", "null"}}}},
+        {"has_mask", {{"type", "boolean"}}}}}};
+  return schema.dump();
+}
+
+std::string encode_ground_truth(std::optional<double> distance_mm, bool has_mask,
+                                std::int64_t timestamp_ns) {
+  json message = {
+      {"timestamp", {{"sec", timestamp_ns / kNsPerSecond}, {"nsec", timestamp_ns % kNsPerSecond}}},
+      {"frame_id", "tof"},
+      {"distance_mm", nullptr},
+      {"has_mask", has_mask}};
+  if (distance_mm) message["distance_mm"] = *distance_mm;
+  return message.dump();
+}
+
+GroundTruthMessage decode_ground_truth(std::string_view text, const std::string& where) {
+  const json message = json::parse(text, nullptr, false);
+  if (message.is_discarded() || !message.is_object()) {
+    throw Error(where + ": message data is not a JSON object");
+  }
+  try {
+    GroundTruthMessage truth;
+    const json& distance = message.at("distance_mm");
+    if (!distance.is_null()) truth.distance_mm = distance.get<double>();
+    truth.has_mask = message.at("has_mask").get<bool>();
+    return truth;
+  } catch (const json::exception& error) {
+    throw Error(where + ": not a tilth.GroundTruth: " + error.what());
+  }
+}
+
+}  // namespace tilth::mcap

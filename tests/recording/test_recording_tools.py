@@ -1,0 +1,267 @@
+"""`tilth simulate` and `tilth recording`, run as a user runs them: what the options do,
+what the outputs hold (read by check_folder.py's own PNG decoder and by numpy, not by
+Tilth), and the message and exit code of each kind of bad input. The round trip through
+both formats is tests/mcap/js/round_trip.test.mjs."""
+import csv
+import json
+import os
+import re
+import subprocess
+import tempfile
+import time
+import unittest
+
+import numpy as np
+
+from check_folder import PNG_GRAY, PNG_RGB, make_frames, read_png, small_calibration, \
+    write_input_recording
+
+TILTH = os.environ["TILTH_BIN"]
+SOURCE = os.environ["TILTH_SOURCE_DIR"]
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def tilth(*args, timeout=120):
+    return subprocess.run([TILTH, *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def quarter_rig(folder):
+    """The paper's rig at a quarter of its resolution: fast to simulate, same views."""
+    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
+        rig = json.load(f)
+    for camera in (rig["depth_camera"], rig["color_camera"]):
+        camera["width"] //= 4
+        camera["height"] //= 4
+        for key in ("fx", "fy", "cx", "cy"):
+            camera[key] /= 4
+    path = os.path.join(folder, "quarter.calib.json")
+    with open(path, "w") as f:
+        json.dump(rig, f, indent=2)
+    return path
+
+
+def frames_csv(folder):
+    with open(os.path.join(folder, "frames.csv"), newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+class Simulate(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.dir = cls.tmp.name
+        cls.rig = quarter_rig(cls.dir)
+        cls.folder = os.path.join(cls.dir, "seed5")
+        cls.result = tilth("simulate", cls.folder, "--preset", "case_b", "--frames", 3, "--seed", 5,
+                           "--calibration", cls.rig)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def test_folder_holds_the_frames_the_options_ask_for(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stderr)
+        self.assertEqual(self.result.stdout, self.folder + ": 3 frames (folder)\n")
+        rows = frames_csv(self.folder)
+        self.assertEqual([int(row["index"]) for row in rows], [0, 1, 2])
+        for i, row in enumerate(rows):
+            depth_ns = 1_000_000_000 + i * 1_000_000_000 // 30  # 30 frames/s, from 1 s
+            self.assertEqual(int(row["depth_timestamp_ns"]), depth_ns)
+            self.assertEqual(int(row["color_timestamp_ns"]), depth_ns + 400_000)
+            self.assertEqual(row["ground_truth_mm"], "518.00")
+            bits, kind, depth = read_png(os.path.join(self.folder, row["depth"]))
+            self.assertEqual((bits, kind, depth.shape), (16, PNG_GRAY, (120, 160)))
+            bits, kind, color = read_png(os.path.join(self.folder, row["color"]))
+            self.assertEqual((bits, kind, color.shape), (8, PNG_RGB, (256, 320, 3)))
+            bits, kind, mask = read_png(os.path.join(self.folder, row["mask"]))
+            self.assertEqual((bits, kind, mask.shape), (8, PNG_GRAY, (120, 160)))
+            self.assertTrue(set(np.unique(mask)) <= {0, 128, 255})
+            self.assertIn(255, mask)  # case_b has straw
+        with open(os.path.join(self.folder, "recording.json")) as f:
+            recording = json.load(f)
+        self.assertEqual(recording["color_format"], "bgr8")
+        self.assertIn("--seed 5", recording["description"])
+        self.assertEqual(read_bytes(os.path.join(self.folder, recording["calibration"])),
+                         read_bytes(self.rig))
+
+    def test_the_seed_decides_the_frames(self):
+        same = self.path("seed5-again")
+        other = self.path("seed6")
+        self.assertEqual(tilth("simulate", same, "--preset", "case_b", "--frames", 1, "--seed", 5,
+                               "--calibration", self.rig).returncode, 0)
+        self.assertEqual(tilth("simulate", other, "--preset", "case_b", "--frames", 1, "--seed", 6,
+                               "--calibration", self.rig).returncode, 0)
+        for name in ("depth/000000.png", "color/000000.png", "mask/000000.png"):
+            self.assertEqual(read_bytes(os.path.join(same, name)),
+                             read_bytes(os.path.join(self.folder, name)), name)
+        _, _, depth5 = read_png(os.path.join(self.folder, "depth/000000.png"))
+        _, _, depth6 = read_png(os.path.join(other, "depth/000000.png"))
+        self.assertGreater(np.count_nonzero(depth5 != depth6), depth5.size // 2)
+
+    def test_output_format_by_extension_or_flag(self):
+        cases = [("b.rec", ["--format", "mcap"], "mcap"),
+                 ("c.mcap", ["--format", "folder"], "folder"),
+                 ("d.mcap", ["--color-format", "bayer_rggb8", "--compression", "lz4"], "mcap")]
+        for name, options, kind in cases:
+            with self.subTest(name=name):
+                result = tilth("simulate", self.path(name), "--preset", "flat", "--frames", 1,
+                               "--calibration", self.rig, *options)
+                self.assertEqual(result.returncode, 0, result.stderr)
+                self.assertIn("1 frames (%s)" % kind, result.stdout)
+                if kind == "mcap":
+                    self.assertEqual(read_bytes(self.path(name))[:8], MCAP_MAGIC)
+                else:
+                    self.assertTrue(os.path.isfile(self.path(name + "/recording.json")))
+        info = tilth("recording", "info", self.path("d.mcap")).stdout
+        self.assertIn("compression: lz4", info)
+
+    def test_fps_paces_like_a_live_camera_and_counts_drops(self):
+        start = time.monotonic()
+        result = tilth("simulate", self.path("paced.mcap"), "--preset", "flat", "--frames", 4,
+                       "--fps", 10, "--calibration", self.rig)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertGreaterEqual(time.monotonic() - start, 0.3)  # 4 frames 0.1 s apart
+        self.assertIn("4 frames (mcap), 0 dropped", result.stdout)
+
+    def test_bad_input_names_the_option(self):
+        existing = self.path("existing.mcap")
+        with open(existing, "w") as f:
+            f.write("not a recording")
+        cases = [
+            (["--preset", "case_z"], 2,
+             r"tilth simulate:--preset: parameter 'preset': expected one of 'flat', 'case_a', .*"
+             r"got \"case_z\""),
+            (["--frames", "-1"], 2,
+             r"tilth simulate:--frames: parameter 'frames': expected an integer >= 0, got -1"),
+            (["--fps", "fast"], 2, r"tilth simulate:--fps: parameter 'fps': expected a number"),
+            (["--format", "avi"], 2, r"--format: expected mcap or folder, got 'avi'"),
+            (["--compression", "lz4"], 2, r"--compression is for MCAP output"),
+            (["--calibration", self.path("none.json")], 1, r"none\.json: cannot read"),
+            (["--frobnicate"], 2, r"unknown option --frobnicate"),
+        ]
+        for options, code, message in cases:
+            with self.subTest(options=options):
+                result = tilth("simulate", self.path("bad"), "--calibration", self.rig, *options)
+                self.assertEqual(result.returncode, code, result.stderr)
+                self.assertRegex(result.stderr, message)
+        result = tilth("simulate", existing, "--calibration", self.rig)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn(existing + ": exists; use --overwrite to replace it", result.stderr)
+        self.assertEqual(tilth("simulate", existing, "--calibration", self.rig, "--preset", "flat",
+                               "--frames", 1, "--overwrite").returncode, 0)
+        self.assertEqual(read_bytes(existing)[:8], MCAP_MAGIC)
+
+
+class Recording(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def test_a_folder_from_elsewhere_survives_import_and_export(self):
+        # Written by check_folder.py's own code, with the calibration inline and truth
+        # and masks on every second frame only.
+        calibration = small_calibration()
+        frames = make_frames(5, 1, calibration)
+        source = self.path("in")
+        write_input_recording(source, frames, "bayer_gbrg8", calibration)
+        with open(os.path.join(source, "recording.json")) as f:
+            recording = json.load(f)
+        recording["calibration"] = calibration
+        with open(os.path.join(source, "recording.json"), "w") as f:
+            json.dump(recording, f)
+
+        imported = tilth("recording", "import", source, self.path("in.mcap"),
+                         "--compression", "lz4")
+        self.assertEqual(imported.returncode, 0, imported.stderr)
+        self.assertEqual(imported.stdout, self.path("in.mcap") + ": 5 frames from " + source + "\n")
+        info = tilth("recording", "info", self.path("in.mcap")).stdout
+        for line in ("compression: lz4", "/tof/raw  5 messages", "/color/image  5 messages",
+                     "/truth  2 messages", "/truth/mask  2 messages", "attachments: rig.calib.json"):
+            self.assertIn(line, info)
+
+        exported = tilth("recording", "export", self.path("in.mcap"), self.path("out"))
+        self.assertEqual(exported.returncode, 0, exported.stderr)
+        rows = frames_csv(self.path("out"))
+        self.assertEqual(len(rows), len(frames))
+        for frame, row in zip(frames, rows):
+            with self.subTest(index=frame["index"]):
+                self.assertEqual(int(row["index"]), frame["index"])
+                self.assertEqual(int(row["depth_timestamp_ns"]), frame["depth_ns"])
+                self.assertEqual(int(row["color_timestamp_ns"]), frame["color_ns"])
+                _, _, depth = read_png(self.path("out/" + row["depth"]))
+                np.testing.assert_array_equal(depth.astype(np.uint16), frame["depth"])
+                _, _, color = read_png(self.path("out/" + row["color"]))
+                np.testing.assert_array_equal(color, frame["color"])
+                if frame["mask"] is None:
+                    self.assertEqual((row["mask"], row["ground_truth_mm"]), ("", ""))
+                else:
+                    _, _, mask = read_png(self.path("out/" + row["mask"]))
+                    np.testing.assert_array_equal(mask, frame["mask"])
+                    self.assertEqual(float(row["ground_truth_mm"]), frame["truth"])
+        with open(self.path("out/recording.json")) as f:
+            self.assertEqual(json.load(f)["color_format"], "bayer_gbrg8")
+        with open(self.path("out/rig.calib.json")) as f:
+            self.assertEqual(json.load(f), calibration)
+
+    def test_bad_input_says_what_and_where(self):
+        folder = self.path("folder")
+        os.makedirs(folder)
+        with open(os.path.join(folder, "frames.csv"), "w") as f:
+            f.write("index\n")
+        not_mcap = os.path.join(folder, "frames.csv")
+        cases = [
+            ([], 2, r"expected a command"),
+            (["frobnicate"], 2, r"unknown command 'frobnicate'"),
+            (["info"], 2, r"info takes FILE"),
+            (["export", not_mcap], 2, r"export takes FILE DIR"),
+            (["info", folder], 1, re.escape(folder) + r": is a folder; info reads MCAP files"),
+            (["info", not_mcap], 1,
+             re.escape(not_mcap) + r": not an MCAP file \(expected the magic bytes"),
+            (["export", not_mcap, self.path("out")], 1, re.escape(not_mcap) + r": not an MCAP file"),
+            (["export", not_mcap, folder], 1,
+             re.escape(folder) + r": exists and is not empty; use --overwrite to replace it"),
+            (["import", folder, self.path("x.mcap")], 1,
+             re.escape(folder) + r"/recording.json: cannot read \(is this an image-folder "
+                                 r"recording\?\)"),
+            (["import", folder, not_mcap], 1,
+             re.escape(not_mcap) + r": exists; use --overwrite to replace it"),
+        ]
+        for args, code, message in cases:
+            with self.subTest(args=args):
+                result = tilth("recording", *args)
+                self.assertEqual(result.returncode, code, result.stderr)
+                self.assertRegex(result.stderr, message)
+        with open(os.path.join(folder, "recording.json"), "w") as f:
+            json.dump({"format": "tilth-image-folder/1", "color_format": "bgr8"}, f)
+        result = tilth("recording", "import", folder, self.path("x.mcap"))
+        self.assertIn(folder + "/recording.json:/calibration: missing required field", result.stderr)
+        with open(os.path.join(folder, "recording.json"), "w") as f:
+            json.dump({"format": "tilth-image-folder/1", "color_format": "bgr8",
+                       "calibration": os.path.join(SOURCE, "calib", "paper_rig.calib.json")}, f)
+        result = tilth("recording", "import", folder, self.path("x.mcap"), "--compression", "zip")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("tilth recording import:--compression: parameter 'compression': expected one "
+                      "of 'zstd', 'lz4', 'none', got \"zip\"", result.stderr)
+        result = tilth("recording", "import", folder, self.path("x.mcap"))
+        self.assertEqual(result.returncode, 1)
+        # The rest is the source stage's to check, with its own message.
+        self.assertIn("frames.csv:1: missing required column 'depth_timestamp_ns'", result.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

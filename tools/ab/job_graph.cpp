@@ -1,0 +1,177 @@
+// The replay graph file of a job (variant "wide", recording "case_c"):
+//   {"include": [{"file": "/abs/measurement-chain.json", "as": "wide@case_c"}],
+//    "nodes": {"recording": {"type": "recording.image_folder", "params": {"path": "/abs/case_c"}},
+//              "evaluation": {"type": "sinks.evaluation", "params": {"path": ".../frames.jsonl"}}},
+//    "edges": [["recording.raw", "wide@case_c/project.raw"], ...],
+//    "runtime": {"max_in_flight": 4, "when_full": "block", "on_error": "skip"}}
+#include "job_graph.h"
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "framework/nearest_names.h"
+#include "tilth/error.h"
+
+namespace tilth::ab {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+std::string node_of(const std::string& endpoint) { return endpoint.substr(0, endpoint.rfind('.')); }
+
+std::vector<std::string> node_names(const GraphSpec& graph) {
+  std::vector<std::string> names;
+  for (const auto& node : graph.nodes) names.push_back(node.name);
+  return names;
+}
+
+bool has_node(const GraphSpec& graph, const std::string& name) {
+  for (const auto& node : graph.nodes) {
+    if (node.name == name) return true;
+  }
+  return false;
+}
+
+NodeSpec* find_node(GraphSpec& graph, const std::string& name) {
+  for (auto& node : graph.nodes) {
+    if (node.name == name) return &node;
+  }
+  return nullptr;
+}
+
+void take_problems(const GraphError& error, Diagnostics& problems) {
+  for (const auto& item : error.diagnostics().items()) problems.add(item.where, item.message);
+}
+
+json replay_graph(const Variant& variant, const Recording& recording, const JobFiles& files,
+                  const JobOptions& options) {
+  const std::string chain = job_label(variant, recording) + "/";
+  json evaluation_params = {{"path", files.frames.string()}};
+  if (options.save_images) evaluation_params["save_images"] = true;
+  json edges = json::array({
+      {"recording.raw", chain + variant.ports.raw},
+      {"recording.color", chain + variant.ports.color},
+      {chain + variant.ports.distance, "evaluation.distance"},
+      {"recording.truth", "evaluation.truth"},
+  });
+  if (variant.ports.mask) edges.push_back({chain + *variant.ports.mask, "evaluation.mask"});
+  if (variant.ports.registered_color && options.save_images && options.save_color) {
+    edges.push_back({chain + *variant.ports.registered_color, "evaluation.color"});
+  }
+  return {
+      {"description",
+       "tilth ab: variant '" + variant.name + "' on recording " + recording.path.string()},
+      {"include", json::array({{{"file", fs::absolute(variant.chain).string()},
+                                {"as", job_label(variant, recording)}}})},
+      {"nodes",
+       {{"recording",
+         {{"type", player_type(recording.format)},
+          {"params", {{"path", recording.path.string()}}}}},
+        {"evaluation", {{"type", "sinks.evaluation"}, {"params", evaluation_params}}}}},
+      {"edges", edges},
+      {"runtime",
+       {{"max_in_flight", options.max_in_flight}, {"when_full", "block"}, {"on_error", "skip"}}},
+  };
+}
+
+void write_file(const fs::path& file, const std::string& text) {
+  std::error_code error;
+  fs::create_directories(file.parent_path(), error);
+  std::ofstream out(file);
+  out << text;
+  if (error || !out.flush()) throw Error(file.string() + ": cannot write the file");
+}
+
+// Type replacements first: a replaced node keeps only the parameters the variant sets.
+void apply_settings(const Variant& variant, const std::string& prefix, GraphSpec& graph) {
+  for (const bool types : {true, false}) {
+    for (const auto& setting : variant.settings) {
+      if (setting.replaces_type() != types) continue;
+      NodeSpec* node = find_node(graph, prefix + setting.node);
+      if (node == nullptr) continue;  // reported by check_variant
+      if (types) {
+        node->type = setting.value.get<std::string>();  // check_variant made sure
+        node->where = setting.where;
+        node->params.clear();
+      } else {
+        node->params[setting.param] = {setting.value, setting.where, setting.base_dir,
+                                       setting.command_line_text};
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::string job_label(const Variant& variant, const Recording& recording) {
+  return variant.name + "@" + recording.name;
+}
+
+std::vector<fs::path> check_variant(Variant& variant, const GraphOverrides& variables,
+                                    Diagnostics& problems) {
+  GraphSpec chain;
+  try {
+    chain = load_graph(variant.chain, {{}, variables.variables});
+  } catch (const GraphError& error) {
+    take_problems(error, problems);
+    return {};
+  }
+  const std::vector<std::string> names = node_names(chain);
+  const std::string in_chain = " in the chain " + variant.chain.string();
+  for (const auto& setting : variant.settings) {
+    if (!has_node(chain, setting.node)) {
+      problems.add(setting.where, "no node '" + setting.node + "'" + in_chain +
+                                      did_you_mean(setting.node, names) +
+                                      " (its nodes: " + quoted_list(names) + ")");
+    } else if (setting.replaces_type() && !setting.value.is_string()) {
+      problems.add(setting.where, "expected a stage type name, got " + setting.value.dump());
+    }
+  }
+  auto& ports = variant.ports;
+  for (const std::string* port : {&ports.raw, &ports.color, &ports.distance}) {
+    if (!has_node(chain, node_of(*port))) {
+      problems.add(variant.chain_where, "variant '" + variant.name + "': no node '" +
+                                            node_of(*port) + "'" + in_chain + " for " + *port +
+                                            "; name the chain's ports in a variants file");
+    }
+  }
+  for (auto* port : {&ports.mask, &ports.registered_color}) {
+    if (!*port || has_node(chain, node_of(**port))) continue;
+    if (ports.optional_ports_named) {
+      problems.add(variant.chain_where, "variant '" + variant.name + "': no node '" +
+                                            node_of(**port) + "'" + in_chain + " for " + **port);
+    }
+    port->reset();
+  }
+  return chain.plugins;
+}
+
+void check_stage_types(const Variant& variant, const StageRegistry& registry,
+                       Diagnostics& problems) {
+  for (const auto& setting : variant.settings) {
+    if (!setting.replaces_type() || !setting.value.is_string()) continue;
+    const std::string type = setting.value.get<std::string>();
+    if (registry.find(type) != nullptr) continue;
+    problems.add(setting.where, "unknown stage type '" + type + "'" +
+                                    did_you_mean(type, registry.type_names()) +
+                                    " (run 'tilth plugins' to list the known types)");
+  }
+}
+
+std::optional<ValidatedGraph> job_graph(const Variant& variant, const Recording& recording,
+                                        const JobFiles& files, const JobOptions& options,
+                                        const StageRegistry& registry, Diagnostics& problems) {
+  write_file(files.graph, replay_graph(variant, recording, files, options).dump(2) + "\n");
+  try {
+    GraphSpec graph = load_graph(files.graph, {{}, options.variables.variables});
+    apply_settings(variant, job_label(variant, recording) + "/", graph);
+    return validate_graph(graph, registry);
+  } catch (const GraphError& error) {
+    take_problems(error, problems);
+    return std::nullopt;
+  }
+}
+
+}  // namespace tilth::ab

@@ -1,0 +1,113 @@
+#include "options.h"
+
+#include <filesystem>
+#include <thread>
+
+#include "command_line.h"
+#include "variant_specs.h"
+
+namespace tilth::ab {
+
+namespace fs = std::filesystem;
+
+const char* const kUsage =
+    R"(usage: tilth ab RECORDING... (--variant NAME[:SETTING] | --variants FILE)...
+                [--out DIR] [options]
+
+Replays each recording through each variant of the measurement chain (one graph per
+variant and recording, several at once, as fast as they go) and compares the variants
+with the recordings' ground truth: distance error, missed and false-valid frames, mask
+IoU / precision / recall, time per stage. Writes DIR/report.html (self-contained),
+summary.json, summary.csv and frames.csv. docs/ab-testing.md explains every figure.
+
+  RECORDING                 an image-folder recording (a folder with recording.json),
+                            an .mcap file, or a folder holding several of them
+  --variant NAME            a variant: the chain as it is ...
+  --variant NAME:SETTING    ... changed by SETTING (repeat the NAME for more):
+                              NODE.type=STAGE_TYPE  another stage type for a node
+                              NODE.PARAM=VALUE      a parameter (VALUE as with --set)
+                              chain=FILE            another chain graph file
+                            e.g. --variant wide:segment.dilation_px=4
+  --variants FILE           variants from a JSON file
+  --chain FILE              the chain the variants change
+                            (default: graphs/measurement-chain.json)
+  --var NAME=VALUE          a graph variable for every graph, e.g. calibration=FILE
+  --out DIR                 where the report goes (default: ab-report); missing or empty
+  --overwrite               replace an earlier report in DIR
+  --jobs N                  graphs run at once (default: the number of cores)
+  --overlays N              frames per recording shown as mask overlays (default 3)
+  --no-soil-below F         a frame whose truth mask is less than F soil has no visible
+                            soil and must be reported invalid (default 0.01)
+  --keep-images             keep every frame's saved masks and colour (DIR/runs/)
+  --quiet                   no progress bar and no summary
+  --verbose                 debug log lines
+)";
+
+namespace {
+
+std::size_t count_option(const cli::CommandLine& line, const std::string& option,
+                         std::size_t fallback) {
+  const auto text = line.value(option);
+  if (!text) return fallback;
+  try {
+    std::size_t used = 0;
+    const long long value = std::stoll(*text, &used);
+    if (used == text->size() && value >= 0) return static_cast<std::size_t>(value);
+  } catch (const std::exception&) {
+  }
+  throw UsageError(option + ": expected a whole number >= 0, got '" + *text + "'");
+}
+
+fs::path default_chain(const cli::CommandLine& line) {
+  if (const auto chain = line.value("--chain")) {
+    if (!fs::is_regular_file(*chain)) throw UsageError("--chain " + *chain + ": no such file");
+    return fs::absolute(*chain).lexically_normal();
+  }
+  return fs::path(TILTH_SOURCE_GRAPHS_DIR) / "measurement-chain.json";
+}
+
+}  // namespace
+
+Options parse_options(int argc, char** argv) {
+  const cli::CommandLine line(argc, argv, 1,
+                              {"--variant", "--variants", "--chain", "--var", "--out", "--jobs",
+                               "--overlays", "--no-soil-below"},
+                              {"--help", "--overwrite", "--keep-images", "--quiet", "--verbose"});
+  Options options;
+  options.help = line.flag("--help");
+  if (options.help) return options;
+  options.verbose = line.flag("--verbose");
+  if (line.positional().empty()) throw UsageError("no recording given");
+  options.recordings = find_recordings(line.positional());
+  const fs::path chain = default_chain(line);
+  for (const auto& file : line.values("--variants")) {
+    add_variants_from_file(file, chain, options.variants);
+  }
+  for (const auto& option : line.values("--variant")) {
+    add_variant_option(option, chain, options.variants);
+  }
+  if (options.variants.empty()) throw UsageError("no variant given: use --variant or --variants");
+  for (const auto& variable : line.values("--var")) {
+    options.variables.variables.push_back(parse_setting("--var", variable));
+  }
+  options.layout.dir = fs::absolute(line.value("--out").value_or("ab-report")).lexically_normal();
+  options.overwrite = line.flag("--overwrite");
+  options.jobs = count_option(line, "--jobs", std::max(1u, std::thread::hardware_concurrency()));
+  if (options.jobs == 0) throw UsageError("--jobs: expected at least 1");
+  options.overlays = count_option(line, "--overlays", 3);
+  if (const auto text = line.value("--no-soil-below")) {
+    try {
+      options.no_soil_below = std::stod(*text);
+    } catch (const std::exception&) {
+      options.no_soil_below = -1.0;
+    }
+    if (!(options.no_soil_below >= 0.0 && options.no_soil_below <= 1.0)) {
+      throw UsageError("--no-soil-below: expected a fraction in [0, 1], got '" + *text + "'");
+    }
+  }
+  options.keep_images = line.flag("--keep-images");
+  options.quiet = line.flag("--quiet");
+  return options;
+}
+
+}  // namespace tilth::ab

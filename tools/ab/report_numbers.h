@@ -1,0 +1,27 @@
+// The numbers of a comparison as files: summary.json (everything the report shows),
+// summary.csv (one row per variant and recording, and per variant over all
+// recordings) and frames.csv (one row per variant, recording and frame). Stage times
+// and frame rates are the only numbers that change from run to run.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "comparison.h"
+#include "overlays.h"
+
+namespace tilth::ab {
+
+// Overlay frames per recording, in the recordings' order.
+using Overlays = std::vector<std::vector<OverlayFrame>>;
+
+nlohmann::ordered_json summary_json(const Comparison& comparison, const Overlays& overlays);
+
+// Throw tilth::Error naming the file when it cannot be written.
+void write_summary_csv(const Comparison& comparison, const std::filesystem::path& file);
+void write_frames_csv(const Comparison& comparison, const std::filesystem::path& file);
+void write_text(const std::filesystem::path& file, const std::string& text);
+
+}  // namespace tilth::ab

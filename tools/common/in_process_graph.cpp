@@ -1,0 +1,55 @@
+#include "in_process_graph.h"
+
+#include <filesystem>
+
+#include "framework/graph_session.h"
+#include "framework/graph_validator.h"
+#include "tilth/error.h"
+
+namespace tilth::tools {
+
+InProcessGraph::InProcessGraph(std::string program) : program_(std::move(program)) {
+  spec_.file = program_;
+  spec_.description = program_;
+}
+
+NodeSpec& InProcessGraph::node(const std::string& name) {
+  for (NodeSpec& node : spec_.nodes) {
+    if (node.name == name) return node;
+  }
+  throw Error(program_ + ": no node '" + name + "' in its graph");
+}
+
+void InProcessGraph::add_node(const std::string& name, const std::string& type,
+                              const nlohmann::json& params) {
+  NodeSpec node;
+  node.name = name;
+  node.type = type;
+  node.where = Location{program_, "/nodes/" + name};
+  for (const auto& [key, value] : params.items()) {
+    node.params[key] = ParamValue{value, node.where.child("params").child(key),
+                                  std::filesystem::current_path(), std::nullopt};
+  }
+  spec_.nodes.push_back(std::move(node));
+}
+
+void InProcessGraph::set_from_option(const std::string& node_name, const std::string& param,
+                                     const std::string& option, const std::string& text) {
+  nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
+  if (value.is_discarded()) value = text;
+  node(node_name).params[param] =
+      ParamValue{value, Location{program_, option}, std::filesystem::current_path(), text};
+}
+
+void InProcessGraph::add_edge(const std::string& from, const std::string& to) {
+  spec_.edges.push_back(
+      {from, to, Location{program_, "/edges/" + std::to_string(spec_.edges.size())}});
+}
+
+RunResult InProcessGraph::run() const {
+  const auto registry = load_plugins({});
+  Runtime runtime(validate_graph(spec_, *registry), *registry);
+  return runtime.run();
+}
+
+}  // namespace tilth::tools

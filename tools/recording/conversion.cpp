@@ -1,0 +1,131 @@
+#include "conversion.h"
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "in_process_graph.h"
+#include "mcap_reader.h"
+#include "output_path.h"
+#include "recording_layout.h"
+#include "tilth/error.h"
+
+namespace tilth::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A private folder under the system's temporary directory, removed with its contents.
+class TemporaryFolder {
+ public:
+  TemporaryFolder() {
+    std::string pattern = (fs::temp_directory_path() / "tilth-recording-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) {
+      throw Error("cannot create a temporary folder like " + pattern);
+    }
+    path_ = pattern;
+  }
+  ~TemporaryFolder() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path file = path_ / name;
+    std::ofstream out(file, std::ios::binary);
+    out << text;
+    if (!out) throw Error(file.string() + ": cannot write");
+    return file;
+  }
+
+ private:
+  fs::path path_;
+};
+
+std::uint64_t run_conversion(const InProcessGraph& graph, const std::string& what) {
+  const RunResult result = graph.run();
+  if (result.failed) throw Error(what + " failed: " + result.failure);
+  return result.metrics.frames_completed;
+}
+
+void connect_recording_ports(InProcessGraph& graph) {
+  for (const std::string port : {"raw", "color", "truth"}) {
+    graph.add_edge("player." + port, "writer." + port);
+  }
+}
+
+// The calibration file that recording.json names, or its inline object written to
+// `scratch`; the rest of recording.json is the source stage's to check.
+fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scratch) {
+  const fs::path file = folder / "recording.json";
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot read (is this an image-folder recording?)");
+  const json recording = json::parse(in, nullptr, false);
+  if (recording.is_discarded() || !recording.is_object()) {
+    throw Error(file.string() + ": expected a JSON object (spec: tilth-image-folder/1)");
+  }
+  const auto calibration = recording.find("calibration");
+  if (calibration == recording.end()) {
+    throw Error(file.string() + ":/calibration: missing required field");
+  }
+  if (calibration->is_string()) return folder / calibration->get<std::string>();
+  if (calibration->is_object()) return scratch.write("rig.calib.json", calibration->dump(2));
+  throw Error(file.string() + ":/calibration: expected a file name or a calibration object, got " +
+              calibration->dump());
+}
+
+}  // namespace
+
+std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder,
+                               const ConversionOptions& options) {
+  check_output_path(folder, options.overwrite);
+  const TemporaryFolder scratch;
+  fs::path calibration;
+  {
+    mcap::McapReader reader(mcap_file);
+    const auto attachment = reader.find_attachment(mcap::kCalibrationAttachment);
+    if (!attachment) {
+      throw Error(mcap_file.string() + ": has no attachment named " +
+                  std::string(mcap::kCalibrationAttachment) +
+                  " (the rig calibration mcap.writer stores); an image folder needs one");
+    }
+    calibration = scratch.write(attachment->name, attachment->data);
+  }
+  InProcessGraph graph("tilth recording export");
+  graph.add_node("player", "mcap.player", {{"path", mcap_file.string()}});
+  graph.add_node("writer", "recording.image_folder_writer",
+                 {{"path", folder.string()},
+                  {"calibration", calibration.string()},
+                  {"overwrite", options.overwrite},
+                  {"description", "exported from " + mcap_file.filename().string()}});
+  connect_recording_ports(graph);
+  graph.set_runtime({4, FullPolicy::kBlock, ErrorPolicy::kStop});
+  return run_conversion(graph, "exporting " + mcap_file.string());
+}
+
+std::uint64_t import_from_folder(const fs::path& folder, const fs::path& mcap_file,
+                                 const ConversionOptions& options) {
+  check_output_path(mcap_file, options.overwrite);
+  const TemporaryFolder scratch;
+  InProcessGraph graph("tilth recording import");
+  graph.add_node("player", "recording.image_folder",
+                 {{"path", folder.string()}, {"on_missing", "stop"}});
+  // Offline: every chunk compressed, however long it takes.
+  graph.add_node("writer", "mcap.writer",
+                 {{"path", mcap_file.string()},
+                  {"calibration", folder_calibration(folder, scratch).string()},
+                  {"when_behind", "wait"}});
+  if (!options.compression.empty()) {
+    graph.set_from_option("writer", "compression", "--compression", options.compression);
+  }
+  connect_recording_ports(graph);
+  graph.set_runtime({4, FullPolicy::kBlock, ErrorPolicy::kStop});
+  return run_conversion(graph, "importing " + folder.string());
+}
+
+}  // namespace tilth::tools

@@ -1,0 +1,30 @@
+// `tilth recording export` and `import`: an MCAP recording to an image-folder recording
+// and back, each by running the recording stages in a graph of their own (player ->
+// writer), so the formats are read and written by the same code as in `tilth run`.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace tilth::tools {
+
+struct ConversionOptions {
+  bool overwrite = false;   // replace an existing output
+  std::string compression;  // import: the MCAP chunk compression; "" = mcap.writer's default
+};
+
+// mcap.player -> recording.image_folder_writer, with the calibration the MCAP file
+// carries. Returns the frames written; throws tilth::Error (or GraphError) saying what
+// and where.
+std::uint64_t export_to_folder(const std::filesystem::path& mcap_file,
+                               const std::filesystem::path& folder,
+                               const ConversionOptions& options);
+
+// recording.image_folder -> mcap.writer, with the calibration recording.json names
+// (a file, or an inline object).
+std::uint64_t import_from_folder(const std::filesystem::path& folder,
+                                 const std::filesystem::path& mcap_file,
+                                 const ConversionOptions& options);
+
+}  // namespace tilth::tools

@@ -1,0 +1,146 @@
+// `tilth simulate` (the tilth-simulate program): renders a preset of the scene simulator
+// into an MCAP recording or an image-folder recording, by running synthetic.scene into
+// the format's writer stage in process.
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "command_line.h"
+#include "commands.h"
+#include "framework/diagnostics.h"
+#include "in_process_graph.h"
+#include "output_path.h"
+#include "tilth/error.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace tilth::cli;
+
+constexpr const char* kUsage = R"(usage: tilth simulate OUTPUT [OPTIONS]
+
+Renders a scene preset of the simulator (ToF raw frames, colour frames, ground-truth
+distance and residue mask) into OUTPUT: an MCAP recording when it ends in .mcap, else
+an image-folder recording.
+
+  --preset NAME          scene preset (default case_c; `tilth describe synthetic.scene`
+                         lists them)
+  --frames N             frames to render (default: the preset's count)
+  --seed N               scene and noise seed (default 1); the same seed gives the same
+                         frames
+  --fps F                render at most F frames/s, as a live camera delivers them, and
+                         drop frames the writer cannot take (default 0: as fast as
+                         possible, nothing dropped). Device timestamps are 30 frames/s
+                         apart either way.
+  --calibration FILE     rig calibration: both cameras' sizes and poses (default: the
+                         paper's rig, calib/paper_rig.calib.json)
+  --color-format F       bgr8 (default) or a Bayer mosaic: bayer_rggb8, bayer_bggr8, ...
+  --format mcap|folder   the output format, whatever OUTPUT's extension
+  --compression C        MCAP chunk compression: zstd (default), lz4 or none
+  --overwrite            replace an existing OUTPUT
+)";
+
+int usage_error(const std::string& message) {
+  std::cerr << "tilth simulate: " << message << "\n\n" << kUsage;
+  return kExitUsage;
+}
+
+// Whether --fps asks for pacing; a malformed value is the stage's to report.
+bool paced(const std::optional<std::string>& fps) {
+  if (!fps) return false;
+  const auto value = nlohmann::json::parse(*fps, nullptr, false);
+  return value.is_number() && value.get<double>() > 0;
+}
+
+// The command as typed, for the recording's description.
+std::string command_text(int argc, char** argv) {
+  std::string text = "tilth simulate";
+  for (int i = 1; i < argc; ++i) text += std::string(" ") + argv[i];
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::optional<CommandLine> parsed;
+  try {
+    parsed.emplace(argc, argv, 1,
+                   std::set<std::string>{"--preset", "--frames", "--seed", "--fps", "--calibration",
+                                         "--color-format", "--format", "--compression"},
+                   std::set<std::string>{"--overwrite", "--help"});
+  } catch (const tilth::Error& error) {
+    return usage_error(error.what());
+  }
+  const CommandLine& line = *parsed;
+  if (line.flag("--help")) {
+    std::cout << kUsage;
+    return kExitOk;
+  }
+  if (line.positional().size() != 1) return usage_error("expected one OUTPUT");
+  const fs::path output = line.positional()[0];
+  const std::string format =
+      line.value("--format").value_or(output.extension() == ".mcap" ? "mcap" : "folder");
+  if (format != "mcap" && format != "folder") {
+    return usage_error("--format: expected mcap or folder, got '" + format + "'");
+  }
+  if (format == "folder" && line.value("--compression")) {
+    return usage_error("--compression is for MCAP output");
+  }
+  const bool overwrite = line.flag("--overwrite");
+  const bool live = paced(line.value("--fps"));
+
+  try {
+    tilth::tools::check_output_path(output, overwrite);
+    tilth::tools::InProcessGraph graph("tilth simulate");
+    graph.add_node("scene", "synthetic.scene", {{"calibration", TILTH_DEFAULT_CALIBRATION}});
+    if (format == "mcap") {
+      // Paced like a camera, the writer keeps up as a live recording does (see
+      // mcap.writer's when_behind); otherwise every chunk is compressed.
+      graph.add_node("writer", "mcap.writer",
+                     {{"path", output.string()},
+                      {"calibration", TILTH_DEFAULT_CALIBRATION},
+                      {"when_behind", live ? "store" : "wait"}});
+    } else {
+      graph.add_node("writer", "recording.image_folder_writer",
+                     {{"path", output.string()},
+                      {"calibration", TILTH_DEFAULT_CALIBRATION},
+                      {"overwrite", overwrite},
+                      {"description", command_text(argc, argv)}});
+    }
+    const auto pass = [&](const std::string& option, const std::string& node,
+                          const std::string& param) {
+      if (const auto text = line.value(option)) graph.set_from_option(node, param, option, *text);
+    };
+    pass("--preset", "scene", "preset");
+    pass("--frames", "scene", "frames");
+    pass("--seed", "scene", "seed");
+    pass("--fps", "scene", "fps");
+    pass("--color-format", "scene", "color_format");
+    pass("--calibration", "scene", "calibration");
+    pass("--calibration", "writer", "calibration");
+    pass("--compression", "writer", "compression");
+    for (const std::string port : {"raw", "color", "truth"}) {
+      graph.add_edge("scene." + port, "writer." + port);
+    }
+    graph.set_runtime({4, live ? tilth::FullPolicy::kDropOldest : tilth::FullPolicy::kBlock,
+                       tilth::ErrorPolicy::kStop});
+
+    const tilth::RunResult result = graph.run();
+    if (result.failed) throw tilth::Error(result.failure);
+    std::cout << output.string() << ": " << result.metrics.frames_completed << " frames (" << format
+              << ")";
+    if (live) std::cout << ", " << result.metrics.frames_dropped << " dropped";
+    std::cout << "\n";
+    return kExitOk;
+  } catch (const tilth::GraphError& error) {
+    std::cerr << error.what() << "\n";
+    return kExitUsage;
+  } catch (const std::exception& error) {
+    std::cerr << "tilth simulate: " << error.what() << "\n";
+    return kExitFailed;
+  }
+}
