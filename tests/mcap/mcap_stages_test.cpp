@@ -1,8 +1,7 @@
 // mcap.writer -> mcap.player through the real runtime: every pixel, timestamp and truth
 // survives in each pixel format and compression; what the file holds (channels,
-// schemas, attachments, metadata, summary); seeking by time; the writer's throughput at
-// the rig's full image sizes.
-#include <sys/resource.h>
+// schemas, attachments, metadata, summary); seeking by time; every chunk compressed at
+// the rig's full image sizes when the writer is told to wait.
 
 #include <chrono>
 #include <fstream>
@@ -160,24 +159,10 @@ TEST_F(McapStagesTest, PacesAtTheRecordedRate) {
   EXPECT_EQ(captured_.size(), 4u);
 }
 
-double process_cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& time) { return time.tv_sec + time.tv_usec * 1e-6; };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
-
-// 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them, every
-// chunk compressed (when_behind: wait). At 30 frame pairs/s a pair may take 33 ms of one
-// core; the writer takes 17-25 ms here (zstd level 1 ~12, the chunk CRC ~3.5, the rest
-// copies and writes, more on a loaded machine; bench/mcap has each part and the live
-// case). The check, 40 ms, catches a regression such as the 55-65 ms of base64 JSON
-// images. Wall time is printed too: on cores shared with other work it is lower than
-// what a free machine reaches.
-TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "throughput is measured without sanitizers";
-#endif
+// 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them: with
+// when_behind: wait every chunk is compressed, however far compression falls behind.
+// (Speed is measured by bench/mcap, not here.)
+TEST_F(McapStagesTest, WaitingWriterCompressesEveryChunk) {
   const json calibration = json::parse(read_text(shipped_calibration_file()));
   const int count = 45;
   frames_ = make_frames(count, calibration, 3);
@@ -191,24 +176,10 @@ TEST_F(McapStagesTest, WriterKeepsUpWithThirtyFramePairsPerSecond) {
     color.convertTo(frame.color, CV_8UC3);
   }
   const fs::path file = dir_.path() / "throughput.mcap";
-  const double cpu_start = process_cpu_seconds();
-  const auto start = std::chrono::steady_clock::now();
   const RunResult recorded =
       record(file, PixelFormat::kBgr8,
              {{"calibration", shipped_calibration_file()}, {"when_behind", "wait"}});
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double cpu_ms_per_pair = (process_cpu_seconds() - cpu_start) * 1e3 / count;
   ASSERT_FALSE(recorded.failed) << recorded.failure;
-  const double frames_per_second = count / seconds;
-  const double megabytes = static_cast<double>(fs::file_size(file)) / 1e6;
-  std::printf(
-      "mcap.writer: %d frame pairs in %.2f s wall = %.1f frame pairs/s; %.1f ms CPU per pair; "
-      "%.1f MB file\n",
-      count, seconds, frames_per_second, cpu_ms_per_pair, megabytes);
-  RecordProperty("frame_pairs_per_second", std::to_string(frames_per_second));
-  RecordProperty("cpu_ms_per_frame_pair", std::to_string(cpu_ms_per_pair));
-  EXPECT_LT(cpu_ms_per_pair, 40.0);
   EXPECT_EQ(mcap::recording_info(file).compressions,
             (std::vector<std::pair<std::string, std::uint64_t>>{{"zstd", count}}));
 }
