@@ -1,7 +1,8 @@
 // The measurement chain on one core: depth.projection -> registration.projective ->
-// segmentation.color_threshold -> estimation.ground_distance, default parameters and the
-// paper's rig, on one frame pair (640x480 depth, 1280x1024 colour) rendered by
-// synthetic.scene (preset case_c), in ms per frame pair.
+// segmentation.color_threshold -> estimation.ground_distance with the parameters of
+// graphs/measurement-chain.json and the paper's rig, on one frame pair (640x480 depth,
+// 1280x1024 colour) rendered by synthetic.scene (preset case_c), in ms per frame pair;
+// and each stage alone on the same frame.
 //
 // allocs_per_frame counts the heap allocations of a frame in the steady state: global
 // operator new / new[] (replaced below) and cv::Mat buffers (which OpenCV takes from
@@ -10,6 +11,7 @@
 #include <array>
 #include <atomic>
 #include <cstdlib>
+#include <map>
 #include <new>
 #include <sstream>
 #include <string>
@@ -85,14 +87,19 @@ StageInstance make(const std::string& type, nlohmann::json params = nlohmann::js
   return registry().create(type, StageContext{type, Params(params), Logger(type), {}});
 }
 
-// One frame pair (raw ToF, colour) of the simulator's case_c in `color_format`.
-std::array<Packet, 2> scene_frame(const std::string& color_format) {
+// One frame pair (raw ToF, colour) of the simulator's case_c in `color_format`, rendered
+// once per format.
+const std::array<Packet, 2>& scene_frame(const std::string& color_format) {
+  static std::map<std::string, std::array<Packet, 2>> rendered;
+  if (const auto found = rendered.find(color_format); found != rendered.end()) {
+    return found->second;
+  }
   StageInstance scene =
       make("synthetic.scene", {{"preset", "case_c"}, {"color_format", color_format}});
   std::vector<Packet> outputs(3);
   Frame frame(FrameInfo{}, {}, outputs);
   dynamic_cast<Source&>(*scene.stage).produce(frame);
-  return {outputs[0], outputs[1]};
+  return rendered[color_format] = {outputs[0], outputs[1]};
 }
 
 void process(StageInstance& stage, std::span<const Packet> inputs, std::span<Packet> outputs) {
@@ -100,44 +107,78 @@ void process(StageInstance& stage, std::span<const Packet> inputs, std::span<Pac
   dynamic_cast<Transform&>(*stage.stage).process(frame);
 }
 
-void chain(benchmark::State& state, const char* color_format) {
-  cv::setNumThreads(0);  // one core: OpenCV's own threads (demosaicing, cvtColor) off too
-  StageInstance project = make("depth.projection");
-  StageInstance reg = make("registration.projective");
-  StageInstance segment = make("segmentation.color_threshold");
-  StageInstance estimate = make("estimation.ground_distance");
-  const std::array<Packet, 2> pair = scene_frame(color_format);
+// The four stages with the parameters of graphs/measurement-chain.json, and the packets of
+// one frame, held here so that running a frame itself allocates nothing.
+class Chain {
+ public:
+  enum Step { kProject, kRegister, kSegment, kEstimate, kWhole };
 
-  // The packets of one frame, held here so that the loop itself allocates nothing.
-  std::array<Packet, 1> depth;
-  std::array<Packet, 2> register_in;
-  std::array<Packet, 1> registered;
-  std::array<Packet, 2> segment_in;
-  std::array<Packet, 2> segmented;
-  std::array<Packet, 1> distance;
-  const auto run_frame = [&] {
-    process(project, std::span(&pair[0], 1), depth);
-    register_in = {depth[0], pair[1]};
-    process(reg, register_in, registered);
-    segment_in = {registered[0], depth[0]};
-    process(segment, segment_in, segmented);
-    process(estimate, std::span(&segmented[1], 1), distance);
-    benchmark::DoNotOptimize(distance[0].message().get());
-    // Every message back to its pool before the next frame.
-    for (const std::span<Packet> packets :
-         {std::span<Packet>(depth), std::span<Packet>(register_in), std::span<Packet>(registered),
-          std::span<Packet>(segment_in), std::span<Packet>(segmented),
-          std::span<Packet>(distance)}) {
-      std::fill(packets.begin(), packets.end(), Packet());
+  explicit Chain(const char* color_format) : pair_(scene_frame(color_format)) {}
+
+  // One stage, or the whole chain, on the frame pair. A stage alone reads the outputs
+  // of the stages before it from the last whole run.
+  void run(Step step) {
+    if (step == kProject || step == kWhole) process(project_, std::span(&pair_[0], 1), depth_);
+    if (step == kRegister || step == kWhole) {
+      register_in_ = {depth_[0], pair_[1]};
+      process(register_, register_in_, registered_);
     }
-  };
-  for (int warm_up = 0; warm_up < 3; ++warm_up) run_frame();
+    if (step == kSegment || step == kWhole) {
+      segment_in_ = {registered_[0], depth_[0]};
+      process(segment_, segment_in_, segmented_);
+    }
+    if (step == kEstimate || step == kWhole) {
+      process(estimate_, std::span(&segmented_[1], 1), distance_);
+      benchmark::DoNotOptimize(distance_[0].message().get());
+    }
+    // A stage's outputs (every message, for the whole chain) go back to its pool before
+    // the next frame.
+    const auto release = [](std::span<Packet> packets) {
+      std::fill(packets.begin(), packets.end(), Packet());
+    };
+    if (step == kWhole) {
+      for (const std::span<Packet> packets :
+           {std::span<Packet>(depth_), std::span<Packet>(register_in_),
+            std::span<Packet>(registered_), std::span<Packet>(segment_in_),
+            std::span<Packet>(segmented_), std::span<Packet>(distance_)}) {
+        release(packets);
+      }
+    } else if (step == kEstimate) {
+      release(distance_);
+    }
+  }
+
+ private:
+  StageInstance project_ = make("depth.projection");
+  StageInstance register_ = make("registration.projective");
+  StageInstance segment_ = make("segmentation.color_threshold", {{"speckle_px", 1}});
+  StageInstance estimate_ = make("estimation.ground_distance");
+  const std::array<Packet, 2> pair_;
+  std::array<Packet, 1> depth_;
+  std::array<Packet, 2> register_in_;
+  std::array<Packet, 1> registered_;
+  std::array<Packet, 2> segment_in_;
+  std::array<Packet, 2> segmented_;
+  std::array<Packet, 1> distance_;
+};
+
+void run(benchmark::State& state, const char* color_format, Chain::Step step) {
+  cv::setNumThreads(0);  // one core: OpenCV's own threads (demosaicing, cvtColor) off too
+  Chain chain(color_format);
+  for (int warm_up = 0; warm_up < 3; ++warm_up) chain.run(Chain::kWhole);
+  if (step != Chain::kWhole) {
+    // Keep the inputs of the measured stage: run the chain up to it once more, and the
+    // stage once more, so that its pool holds the message the next frame writes into.
+    for (int before = Chain::kProject; before <= step; ++before) {
+      chain.run(static_cast<Chain::Step>(before));
+    }
+  }
 
   CountingMatAllocator counting;
   cv::MatAllocator* const previous = cv::Mat::getDefaultAllocator();
   cv::Mat::setDefaultAllocator(&counting);
   const std::int64_t before = allocations.load();
-  for (auto _ : state) run_frame();
+  for (auto _ : state) chain.run(step);
   const std::int64_t counted = allocations.load() - before;
   cv::Mat::setDefaultAllocator(previous);
 
@@ -146,18 +187,40 @@ void chain(benchmark::State& state, const char* color_format) {
   state.SetLabel(color_format);
 }
 
+void chain(benchmark::State& state, const char* color_format) {
+  run(state, color_format, Chain::kWhole);
+}
+void project(benchmark::State& state, const char* color_format) {
+  run(state, color_format, Chain::kProject);
+}
+void register_color(benchmark::State& state, const char* color_format) {
+  run(state, color_format, Chain::kRegister);
+}
+void segment(benchmark::State& state, const char* color_format) {
+  run(state, color_format, Chain::kSegment);
+}
+void estimate(benchmark::State& state, const char* color_format) {
+  run(state, color_format, Chain::kEstimate);
+}
+
 // The machine is shared: the fastest repetition is the chain's own cost, the median
 // what it gets under the current load.
 double fastest(const std::vector<double>& times) {
   return *std::min_element(times.begin(), times.end());
 }
 
-BENCHMARK_CAPTURE(chain, bgr8, "bgr8")
-    ->Unit(benchmark::kMillisecond)
-    ->ComputeStatistics("min", fastest);
-BENCHMARK_CAPTURE(chain, bayer_rggb8, "bayer_rggb8")
-    ->Unit(benchmark::kMillisecond)
-    ->ComputeStatistics("min", fastest);
+#define TILTH_CHAIN_BENCHMARK(function, format) \
+  BENCHMARK_CAPTURE(function, format, #format)  \
+      ->Unit(benchmark::kMillisecond)           \
+      ->ComputeStatistics("min", fastest)
+
+TILTH_CHAIN_BENCHMARK(chain, bgr8);
+TILTH_CHAIN_BENCHMARK(chain, bayer_rggb8);
+TILTH_CHAIN_BENCHMARK(project, bgr8);
+TILTH_CHAIN_BENCHMARK(register_color, bgr8);
+TILTH_CHAIN_BENCHMARK(register_color, bayer_rggb8);
+TILTH_CHAIN_BENCHMARK(segment, bgr8);
+TILTH_CHAIN_BENCHMARK(estimate, bgr8);
 
 }  // namespace
 }  // namespace tilth

@@ -12,12 +12,15 @@
 //                           "statistic": "median", "min_soil_fraction": 0.05}}
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
-#include <numeric>
 #include <span>
 #include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 #include "estimators.h"
+#include "rank_selection.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
@@ -31,30 +34,18 @@ namespace {
 // Scales the median absolute deviation to the standard deviation of normal data.
 constexpr double kMadToSigma = 1.4826;
 
-// nth_element, not a sort: linear time. Reorders `values`.
-double median_in_place(std::span<float> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  if (values.size() % 2 == 1) return *middle;
-  const float below = *std::max_element(values.begin(), middle);
-  return 0.5 * (static_cast<double>(below) + static_cast<double>(*middle));
+// The median (the mean of the middle two for an even count) of the indexed values.
+double median(RankSelection& ranks, std::size_t count) {
+  const float upper = ranks.at_rank(count / 2);
+  if (count % 2 == 1) return upper;
+  return 0.5 * (static_cast<double>(ranks.at_rank(count / 2 - 1)) + static_cast<double>(upper));
 }
 
-// The mean of what is left after dropping `trim_fraction` of the values at each end.
-double trimmed_mean_in_place(std::span<float> values, double trim_fraction) {
-  const auto cut = static_cast<std::ptrdiff_t>(trim_fraction * static_cast<double>(values.size()));
-  const auto first = values.begin() + cut;
-  const auto last = values.end() - cut;
-  if (cut > 0) {
-    std::nth_element(values.begin(), first, values.end());
-    std::nth_element(first, last, values.end());  // only ranks >= cut remain to split
-  }
-  return std::accumulate(first, last, 0.0) / static_cast<double>(last - first);
-}
-
-double spread_in_place(std::span<float> values, double median) {
-  for (float& value : values) value = static_cast<float>(std::abs(value - median));
-  return kMadToSigma * median_in_place(values);
+// The mean of what is left after dropping `trim_fraction` of the indexed values at each end.
+double trimmed_mean(RankSelection& ranks, std::size_t count, double trim_fraction) {
+  const auto cut = static_cast<std::size_t>(trim_fraction * static_cast<double>(count));
+  return (ranks.sum_of_smallest(count - cut) - ranks.sum_of_smallest(cut)) /
+         static_cast<double>(count - 2 * cut);
 }
 
 enum class Statistic { kMedian, kTrimmedMean };
@@ -82,8 +73,8 @@ class GroundDistanceEstimator final : public Transform {
                      [&] { log_.warning(region_.clipping_note(soil.mm.size())); });
     }
 
-    thread_local std::vector<float> depths;
-    collect_finite(soil.mm, roi, depths);
+    thread_local std::vector<float> buffer;
+    const std::span<float> depths = collect_finite(soil.mm, roi, buffer);
     const auto message = outputs_.acquire();
     GroundDistance& out = *message;
     out = GroundDistance{};  // a reused message keeps its string's buffer
@@ -95,30 +86,59 @@ class GroundDistanceEstimator final : public Transform {
   }
 
  private:
-  static void collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
-                             std::vector<float>& depths) {
-    depths.clear();
-    depths.reserve(static_cast<std::size_t>(roi.area()));
+  // Four pixels at a time: soil and residue come in patches, so four depths are mostly
+  // all finite or all not. Mixed groups are stored without a branch per pixel: every
+  // depth is stored, and the count moves on past the finite ones.
+  static std::span<float> collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
+                                         std::vector<float>& depths) {
+    // One slot more for the last store. Never shrunk, so no frame after the first
+    // allocates or clears it.
+    const auto slots = static_cast<std::size_t>(roi.area()) + 1;
+    if (depths.size() < slots) depths.resize(slots);
+    float* const out = depths.data();
+    std::size_t count = 0;
+    const auto collect = [&](const float* depth, int first, int end) {
+      for (int col = first; col < end; ++col) {
+        out[count] = depth[col];
+        count += std::isfinite(depth[col]) ? 1 : 0;
+      }
+    };
+    const cv::v_float32x4 largest = cv::v_setall_f32(std::numeric_limits<float>::max());
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
       const float* depth = depth_mm.ptr<float>(row);
-      for (int col = roi.x; col < roi.x + roi.width; ++col) {
-        if (std::isfinite(depth[col])) depths.push_back(depth[col]);
+      int col = roi.x;
+      for (; col + 4 <= roi.x + roi.width; col += 4) {
+        const cv::v_float32x4 four = cv::v_load(depth + col);
+        const int finite = cv::v_signmask(cv::v_abs(four) <= largest);  // NaN, inf: false
+        if (finite == 0xF) {
+          cv::v_store(out + count, four);
+          count += 4;
+        } else if (finite != 0) {
+          collect(depth, col, col + 4);
+        }
       }
+      collect(depth, col, roi.x + roi.width);
     }
+    return {out, count};
   }
 
+  // The trimmed mean, the median and the spread from one histogram of the depths each.
   void measure(std::span<float> depths, GroundDistance& out) const {
-    // The trimmed mean first: the median and the spread reorder and overwrite the values.
+    thread_local RankSelection ranks;
+    const std::size_t count = depths.size();
+    ranks.index(depths);
+    const double median_mm = median(ranks, count);
     const double distance_mm =
-        statistic_ == Statistic::kTrimmedMean ? trimmed_mean_in_place(depths, trim_fraction_) : 0.0;
-    const double median_mm = median_in_place(depths);
-    out.spread_mm = spread_in_place(depths, median_mm);
+        statistic_ == Statistic::kMedian ? median_mm : trimmed_mean(ranks, count, trim_fraction_);
+    for (float& depth : depths) depth = static_cast<float>(std::abs(depth - median_mm));
+    ranks.index(depths);
+    out.spread_mm = kMadToSigma * median(ranks, count);
     if (max_spread_mm_ > 0 && out.spread_mm > max_spread_mm_) {
       out.invalid_reason = "soil depths spread too widely: " + one_decimal(out.spread_mm) +
                            " mm > " + one_decimal(max_spread_mm_) + " mm (not one surface?)";
       return;
     }
-    out.distance_mm = statistic_ == Statistic::kMedian ? median_mm : distance_mm;
+    out.distance_mm = distance_mm;
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm);
   }

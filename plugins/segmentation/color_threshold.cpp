@@ -19,11 +19,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "bit_mask.h"
+#include "color_range_table.h"
+#include "residue_rows.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
@@ -62,10 +69,10 @@ ColorSpace parse_color_space(const std::string& name) {
   throw Error("parameter 'color_space': expected one of 'hsv', 'lab', 'bgr', got '" + name + "'");
 }
 
-cv::Scalar residue_bound(const Params& params, const std::string& name,
-                         const std::array<int, 3>& fallback) {
+std::array<int, 3> residue_bound(const Params& params, const std::string& name,
+                                 const std::array<int, 3>& fallback) {
   const nlohmann::json& value = params.json(name);
-  if (value.is_null()) return {double(fallback[0]), double(fallback[1]), double(fallback[2])};
+  if (value.is_null()) return fallback;
   const bool shaped =
       value.is_array() && value.size() == 3 &&
       std::all_of(value.begin(), value.end(), [](const nlohmann::json& channel) {
@@ -77,18 +84,36 @@ cv::Scalar residue_bound(const Params& params, const std::string& name,
                 "8-bit channels), got " +
                 value.dump());
   }
-  return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
+  return {value[0].get<int>(), value[1].get<int>(), value[2].get<int>()};
 }
 
-void check_bounds_ordered(const cv::Scalar& lower, const cv::Scalar& upper, ColorSpace space) {
+void check_bounds_ordered(const std::array<int, 3>& lower, const std::array<int, 3>& upper,
+                          ColorSpace space) {
   for (int channel = 0; channel < 3; ++channel) {
     if (lower[channel] > upper[channel]) {
       throw Error("parameters 'residue_lower' and 'residue_upper': channel " +
                   std::string(info(space).channels[channel]) + " lower bound " +
-                  std::to_string(int(lower[channel])) + " > upper bound " +
-                  std::to_string(int(upper[channel])) + " (expected lower <= upper)");
+                  std::to_string(lower[channel]) + " > upper bound " +
+                  std::to_string(upper[channel]) + " (expected lower <= upper)");
     }
   }
+}
+
+// The BGR colours in the configured residue range.
+ColorRangeTable residue_colors(const Params& params) {
+  const ColorSpace space = parse_color_space(params.string("color_space"));
+  const auto lower = residue_bound(params, "residue_lower", info(space).residue_lower);
+  const auto upper = residue_bound(params, "residue_upper", info(space).residue_upper);
+  check_bounds_ordered(lower, upper, space);
+  switch (space) {
+    case ColorSpace::kHsv:
+      return ColorRangeTable(cv::COLOR_BGR2HSV, lower, upper);
+    case ColorSpace::kLab:
+      return ColorRangeTable(cv::COLOR_BGR2Lab, lower, upper);
+    case ColorSpace::kBgr:
+      break;
+  }
+  return ColorRangeTable(-1, lower, upper);
 }
 
 std::string size_text(const cv::Mat& image) {
@@ -111,15 +136,14 @@ void check_inputs(const RegisteredColor& color, const DepthImage& depth) {
   }
 }
 
-// Per-thread working images: the stage runs frames concurrently, and these keep their
+// Per-thread working masks: the stage runs frames concurrently, and these keep their
 // buffers from one frame to the next on the same thread.
 struct Scratch {
-  cv::Mat converted;
-  cv::Mat residue;
-  cv::Mat untrusted;  // 255 where the colour cannot be used
-  cv::Mat dark;       // 255 where every channel is below min_value
-  cv::Mat unknown;    // 255 where the colour cannot be used or there is no depth
-  cv::Mat soil;       // 255 where the mask says soil
+  BitMask residue;  // trusted colour in the residue range; then despeckled and dilated
+  BitMask unknown;  // untrusted colour or no depth
+  BitMask morphology;
+  std::vector<std::uint8_t> in_range;  // one row: 255 where the colour is in the range
+  std::vector<std::uint8_t> dark;      // one row: 255 where every channel is below min_value
 };
 
 class ColorThreshold final : public Transform {
@@ -128,19 +152,10 @@ class ColorThreshold final : public Transform {
   enum OutputPort { kMask = 0, kSoilDepth = 1 };
 
   explicit ColorThreshold(const StageContext& context)
-      : space_(parse_color_space(context.params.string("color_space"))),
-        lower_(residue_bound(context.params, "residue_lower", info(space_).residue_lower)),
-        upper_(residue_bound(context.params, "residue_upper", info(space_).residue_upper)),
+      : residue_colors_(residue_colors(context.params)),
         dilation_px_(static_cast<int>(context.params.integer("dilation_px"))),
-        min_value_(static_cast<int>(context.params.integer("min_value"))),
-        kernel_(cv::getStructuringElement(cv::MORPH_RECT,
-                                          {2 * dilation_px_ + 1, 2 * dilation_px_ + 1})),
-        speckle_kernel_(cv::getStructuringElement(
-            cv::MORPH_RECT, {2 * static_cast<int>(context.params.integer("speckle_px")) + 1,
-                             2 * static_cast<int>(context.params.integer("speckle_px")) + 1})),
-        despeckle_(context.params.integer("speckle_px") > 0) {
-    check_bounds_ordered(lower_, upper_, space_);
-  }
+        speckle_px_(static_cast<int>(context.params.integer("speckle_px"))),
+        min_value_(static_cast<int>(context.params.integer("min_value"))) {}
 
   void process(Frame& frame) override {
     const auto& color = frame.input<RegisteredColor>(kColor);
@@ -153,67 +168,81 @@ class ColorThreshold final : public Transform {
     reuse_or_create(soil->mm, depth.mm.rows, depth.mm.cols, CV_32FC1);
 
     thread_local Scratch scratch;
-    mark_untrusted(color, scratch);
-    const cv::Mat& converted = convert(color.bgr, scratch.converted);
-    // Without dilation the in-range result is the mask itself, before unknowns are marked.
-    cv::Mat& residue = dilation_px_ > 0 ? scratch.residue : mask->values;
-    cv::inRange(converted, lower_, upper_, residue);
-    // An untrusted colour may fall in the range by chance (an occluded pixel carries the
-    // colour of what hides it); it must not grow into its neighbours.
-    cv::subtract(residue, scratch.untrusted, residue);  // saturates: 255 - 255 = 0
-    // Isolated specks (sensor noise, demosaicing artefacts on soil texture) would
-    // otherwise each be dilated into a square of lost soil.
-    if (despeckle_) cv::morphologyEx(residue, residue, cv::MORPH_OPEN, speckle_kernel_);
-    if (dilation_px_ > 0) cv::dilate(residue, mask->values, kernel_);
-    label_and_subtract(depth.mm, scratch, mask->values, soil->mm);
+    min_value_ > 0 ? classify<true>(color, depth.mm, scratch)
+                   : classify<false>(color, depth.mm, scratch);
+    // An opening (erosion, then dilation by the same square) drops the specks; its
+    // dilation and the edge dilation that follows add up to one square.
+    scratch.residue.erode(speckle_px_, scratch.morphology);
+    scratch.residue.dilate(speckle_px_ + dilation_px_, scratch.morphology);
+    write_outputs(scratch, depth.mm, mask->values, soil->mm);
 
     frame.set_output(kMask, mask);
     frame.set_output(kSoilDepth, soil);
   }
 
  private:
-  const cv::Mat& convert(const cv::Mat& bgr, cv::Mat& converted) const {
-    switch (space_) {
-      case ColorSpace::kHsv:
-        cv::cvtColor(bgr, converted, cv::COLOR_BGR2HSV);
-        return converted;
-      case ColorSpace::kLab:
-        cv::cvtColor(bgr, converted, cv::COLOR_BGR2Lab);
-        return converted;
-      case ColorSpace::kBgr:
-        break;
+  // Marks, per pixel, residue (a trusted colour in the range) and unknown (an untrusted
+  // colour, or no depth). An untrusted colour may fall in the range by chance (an occluded
+  // pixel carries the colour of what hides it); it must not grow into its neighbours.
+  template <bool kCheckDark>
+  void classify(const RegisteredColor& color, const cv::Mat& depth_mm, Scratch& scratch) const {
+    const int rows = depth_mm.rows;
+    const int cols = depth_mm.cols;
+    scratch.residue.resize(rows, cols);
+    scratch.unknown.resize(rows, cols);
+    scratch.in_range.resize(static_cast<std::size_t>(cols));
+    scratch.dark.resize(kCheckDark ? static_cast<std::size_t>(cols) : 0);
+    std::uint8_t* const in_range = scratch.in_range.data();
+    std::uint8_t* const dark = scratch.dark.data();
+    const std::uint8_t* const table = residue_colors_.data();
+    for (int y = 0; y < rows; ++y) {
+      const auto* bgr = color.bgr.ptr<std::uint8_t>(y);
+      // The table lookup, one load per pixel, is the stage's main cost: each pixel's
+      // three bytes are read as one four-byte word, except the row's last pixel, whose
+      // fourth byte may lie beyond the image.
+      for (int x = 0; x + 1 < cols; ++x) {
+        std::uint32_t bytes;
+        std::memcpy(&bytes, bgr + 3 * x, sizeof bytes);
+        in_range[x] = table[bytes & 0xFFFFFF];
+      }
+      if (cols > 0) {
+        const std::uint8_t* last = bgr + 3 * (cols - 1);
+        in_range[cols - 1] = residue_colors_.contains(last[0], last[1], last[2]) ? 255 : 0;
+      }
+      if constexpr (kCheckDark) {
+        for (int x = 0; x < cols; ++x) {
+          const std::uint8_t* pixel = bgr + 3 * x;
+          dark[x] = std::max({pixel[0], pixel[1], pixel[2]}) < min_value_ ? 255 : 0;
+        }
+      }
+      const auto* status = color.status.ptr<std::uint8_t>(y);
+      const auto* depth = depth_mm.ptr<float>(y);
+      std::uint64_t* residue = scratch.residue.row(y);
+      std::uint64_t* unknown = scratch.unknown.row(y);
+      for (int x = 0; x < cols; x += 64) {
+        const int count = std::min(64, cols - x);
+        const std::uint64_t dark_bits = kCheckDark ? marked_bits(dark + x, count) : 0;
+        const std::uint64_t trusted = valid_status_bits(status + x, count) & ~dark_bits;
+        const std::uint64_t pixels =
+            count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
+        residue[x / 64] = marked_bits(in_range + x, count) & trusted;
+        unknown[x / 64] = (~trusted | missing_depth_bits(depth + x, count)) & pixels;
+      }
     }
-    return bgr;
   }
 
-  void mark_untrusted(const RegisteredColor& color, Scratch& scratch) const {
-    cv::compare(color.status, RegisteredColor::kValid, scratch.untrusted, cv::CMP_NE);
-    if (min_value_ == 0) return;
-    cv::inRange(color.bgr, cv::Scalar::all(0), cv::Scalar::all(min_value_ - 1), scratch.dark);
-    cv::bitwise_or(scratch.untrusted, scratch.dark, scratch.untrusted);
+  static void write_outputs(const Scratch& scratch, const cv::Mat& depth_mm, cv::Mat& mask,
+                            cv::Mat& soil_mm) {
+    for (int y = 0; y < depth_mm.rows; ++y) {
+      write_residue_row(scratch.unknown.row(y), scratch.residue.row(y), depth_mm.ptr<float>(y),
+                        depth_mm.cols, mask.ptr<std::uint8_t>(y), soil_mm.ptr<float>(y));
+    }
   }
 
-  // Marks the unknowns in the dilated residue mask (255/0) and writes the soil pixels' depth.
-  static void label_and_subtract(const cv::Mat& depth_mm, Scratch& scratch, cv::Mat& mask,
-                                 cv::Mat& soil_mm) {
-    // NaN is the one value unequal to itself (OpenCV's CMP_NE does not say so for NaN).
-    cv::compare(depth_mm, depth_mm, scratch.unknown, cv::CMP_EQ);
-    cv::bitwise_not(scratch.unknown, scratch.unknown);
-    cv::bitwise_or(scratch.unknown, scratch.untrusted, scratch.unknown);
-    mask.setTo(ResidueMask::kUnknown, scratch.unknown);
-    cv::compare(mask, ResidueMask::kSoil, scratch.soil, cv::CMP_EQ);
-    soil_mm.setTo(std::numeric_limits<float>::quiet_NaN());
-    depth_mm.copyTo(soil_mm, scratch.soil);
-  }
-
-  const ColorSpace space_;
-  const cv::Scalar lower_;
-  const cv::Scalar upper_;
+  const ColorRangeTable residue_colors_;
   const int dilation_px_;
+  const int speckle_px_;
   const int min_value_;
-  const cv::Mat kernel_;
-  const cv::Mat speckle_kernel_;
-  const bool despeckle_;
   MessagePool<ResidueMask> masks_;
   MessagePool<DepthImage> soil_depths_;
 };

@@ -40,6 +40,25 @@ const std::vector<ScenePreset>& scene_presets() {
     wet.straws = 150;
     wet.wet_straw = true;
     list.push_back(wet);
+    ScenePreset shadows = a;
+    shadows.name = "shadows";
+    shadows.description =
+        "dense stubble 120 mm high and 150 straws: long shadows over soil and straw, 518 mm";
+    shadows.stubble = 400;
+    shadows.stubble_height_mm = 120.0;
+    shadows.straws = 150;
+    list.push_back(shadows);
+    ScenePreset mat = a;
+    mat.name = "covered_mat";
+    mat.description =
+        "1000 straws piled up to 250 mm: under 2 % of the soil visible, with depth and colour";
+    mat.straws = 1000;
+    list.push_back(mat);
+    ScenePreset wet_mat = mat;
+    wet_mat.name = "covered_wet";
+    wet_mat.description = "covered_mat with dark, wet straw: soil-coloured residue over it all";
+    wet_mat.wet_straw = true;
+    list.push_back(wet_mat);
     ScenePreset layered;
     layered.name = "layered";
     layered.description =

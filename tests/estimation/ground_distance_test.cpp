@@ -1,9 +1,11 @@
 // estimation.ground_distance: the median and trimmed mean of soil depths with noise and
 // outliers against their closed forms for a normal sample, exact statistics on small
 // regions, the validity rules with their reasons, and the region of interest.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -139,6 +141,48 @@ TEST_F(NoisySoilWithOutliers, TrimmedMeanIsTheTruncatedNormalMean) {
   EXPECT_NEAR(out.distance_mm, expected_mm, 0.04);
   // 0.1 mm from the median here: the tolerance tells the statistics apart.
   EXPECT_GT(std::abs(expected_mm - inlier_quantile((0.5 * n_ - n_out_) / n_in_)), 0.08);
+}
+
+// The statistics found through a histogram of the depths are those of the sorted depths,
+// to the last bit, with 40 % of the region masked as residue.
+TEST_F(NoisySoilWithOutliers, StatisticsAreThoseOfTheSortedDepths) {
+  cv::Mat soil = depth_.clone();
+  cv::Mat residue(soil.size(), CV_8UC1);
+  cv::RNG(2).fill(residue, cv::RNG::UNIFORM, 0, 100);
+  soil.setTo(kNaN, residue < 40);
+  std::vector<float> depths;
+  for (int v = kDefaultRoi.y; v < kDefaultRoi.y + kDefaultRoi.height; ++v) {
+    for (int u = kDefaultRoi.x; u < kDefaultRoi.x + kDefaultRoi.width; ++u) {
+      if (!std::isnan(soil.at<float>(v, u))) depths.push_back(soil.at<float>(v, u));
+    }
+  }
+  const auto median_of = [](std::vector<float> values) {
+    std::sort(values.begin(), values.end());
+    const std::size_t n = values.size();
+    return n % 2 == 1 ? double{values[n / 2]}
+                      : 0.5 * (double{values[n / 2 - 1]} + double{values[n / 2]});
+  };
+  const double median_mm = median_of(depths);
+  std::vector<float> deviations;
+  for (const float depth : depths) {
+    deviations.push_back(static_cast<float>(std::abs(depth - median_mm)));
+  }
+  std::vector<float> sorted = depths;
+  std::sort(sorted.begin(), sorted.end());
+  const auto cut = static_cast<std::ptrdiff_t>(0.25 * static_cast<double>(sorted.size()));
+  const double trimmed_mm = std::accumulate(sorted.begin() + cut, sorted.end() - cut, 0.0) /
+                            static_cast<double>(sorted.size() - 2 * cut);
+
+  const GroundDistance median = estimate(soil);
+  const GroundDistance trimmed =
+      estimate(soil, {{"statistic", "trimmed_mean"}, {"trim_fraction", 0.25}});
+  ASSERT_TRUE(median.valid) << median.invalid_reason;
+  ASSERT_TRUE(trimmed.valid) << trimmed.invalid_reason;
+  EXPECT_EQ(median.soil_pixels, static_cast<std::int64_t>(depths.size()));
+  EXPECT_EQ(median.distance_mm, median_mm);
+  EXPECT_EQ(trimmed.distance_mm, trimmed_mm);
+  EXPECT_EQ(median.spread_mm, 1.4826 * median_of(deviations));
+  EXPECT_EQ(trimmed.spread_mm, median.spread_mm);
 }
 
 // Depths i^2 for i = 1..100 in a 10x10 region, larger values outside it.

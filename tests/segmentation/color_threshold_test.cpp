@@ -7,11 +7,13 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
@@ -294,6 +296,122 @@ TEST(ColorThreshold, ColourNotOnTheDepthGridIsAnError) {
                  "(expected colour registered onto the depth grid)");
   }
 }
+
+// The stage computes its mask from a colour table and packed bit masks; the paper's steps
+// done one after another with OpenCV's own operations must give the same outputs, pixel
+// for pixel, on noisy frames of straw, soil and random colours with untrusted colours and
+// missing depth, for every colour space and for dilation, speck removal and min_value.
+struct Steps {
+  std::string space;
+  int conversion;  // -1: none
+  std::vector<int> lower;
+  std::vector<int> upper;
+  int dilation_px;
+  int speckle_px;
+  int min_value;
+};
+
+Output segment_step_by_step(const Scene& scene, const Steps& steps) {
+  const auto square = [](int radius) {
+    return cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1});
+  };
+  const cv::Mat& bgr = scene.color->bgr;
+  cv::Mat untrusted = scene.color->status != RegisteredColor::kValid;
+  if (steps.min_value > 0) {
+    cv::Mat dark;
+    cv::inRange(bgr, cv::Scalar::all(0), cv::Scalar::all(steps.min_value - 1), dark);
+    untrusted |= dark;
+  }
+  cv::Mat converted;  // not sharing bgr's pixels: cvtColor would write into them
+  if (steps.conversion >= 0) {
+    cv::cvtColor(bgr, converted, steps.conversion);
+  } else {
+    converted = bgr;
+  }
+  cv::Mat residue;
+  cv::inRange(converted, cv::Scalar(steps.lower[0], steps.lower[1], steps.lower[2]),
+              cv::Scalar(steps.upper[0], steps.upper[1], steps.upper[2]), residue);
+  residue &= ~untrusted;
+  if (steps.speckle_px > 0) {
+    cv::morphologyEx(residue, residue, cv::MORPH_OPEN, square(steps.speckle_px));
+  }
+  if (steps.dilation_px > 0) cv::dilate(residue, residue, square(steps.dilation_px));
+  const cv::Mat& depth = scene.depth->mm;
+  cv::Mat has_depth;
+  cv::compare(depth, depth, has_depth, cv::CMP_EQ);  // false only for NaN
+  residue.setTo(ResidueMask::kUnknown, untrusted | ~has_depth);
+  cv::Mat soil(depth.size(), CV_32FC1, cv::Scalar(kNaN));
+  depth.copyTo(soil, residue == ResidueMask::kSoil);
+  return {residue, soil};
+}
+
+// Straw and soil in blocks with colour noise, 2 % of the pixels any colour at all,
+// 5 % untrusted, 5 % without depth; 131 px wide, so rows end inside a word.
+Scene noisy_frame() {
+  const cv::Size size(131, 97);
+  Scene scene;
+  scene.color->bgr.create(size, CV_8UC3);
+  scene.color->status.create(size, CV_8UC1);
+  scene.depth->mm.create(size, CV_32FC1);
+  const cv::Vec3b reddish_soil(60, 85, 140);  // hue 9: its noise stays clear of straw's 18
+  cv::RNG random(3);
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      const bool straw = ((u / 20) + (v / 16)) % 3 == 0;
+      const bool any_colour = random.uniform(0.0, 1.0) < 0.02;
+      cv::Vec3b& bgr = scene.color->bgr.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) {
+        const double base = any_colour ? random.uniform(0.0, 256.0)
+                            : straw    ? kStraw[c]
+                                       : reddish_soil[c];
+        bgr[c] = cv::saturate_cast<std::uint8_t>(base + random.gaussian(6));
+      }
+      scene.color->status.at<std::uint8_t>(v, u) =
+          random.uniform(0.0, 1.0) < 0.05 ? RegisteredColor::kOccluded : RegisteredColor::kValid;
+      scene.depth->mm.at<float>(v, u) =
+          random.uniform(0.0, 1.0) < 0.05 ? kNaN : static_cast<float>(500.0 + random.gaussian(3));
+    }
+  }
+  return scene;
+}
+
+class StepByStep : public ::testing::TestWithParam<Steps> {};
+
+TEST_P(StepByStep, TheStageGivesTheSameMaskAndSoilDepth) {
+  const Steps& steps = GetParam();
+  const Scene scene = noisy_frame();
+  const Output expected = segment_step_by_step(scene, steps);
+  const Output out = segment(scene, {{"color_space", steps.space},
+                                     {"residue_lower", steps.lower},
+                                     {"residue_upper", steps.upper},
+                                     {"dilation_px", steps.dilation_px},
+                                     {"speckle_px", steps.speckle_px},
+                                     {"min_value", steps.min_value}});
+  EXPECT_EQ(cv::countNonZero(out.mask != expected.mask), 0);
+  EXPECT_EQ(count_finite(out.soil_depth_mm), count_finite(expected.soil_depth_mm));
+  cv::Mat same;
+  cv::compare(out.soil_depth_mm, expected.soil_depth_mm, same, cv::CMP_EQ);  // NaN: unequal
+  EXPECT_EQ(cv::countNonZero(same), count_finite(expected.soil_depth_mm));
+  // Each class is present, so the comparison says something about each.
+  for (const std::uint8_t value :
+       {ResidueMask::kSoil, ResidueMask::kResidue, ResidueMask::kUnknown}) {
+    EXPECT_GT(count_equal(expected.mask, value), 200) << int(value);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    ColorThreshold, StepByStep,
+    ::testing::Values(Steps{"hsv", cv::COLOR_BGR2HSV, {18, 40, 50}, {40, 255, 255}, 2, 0, 0},
+                      Steps{"hsv", cv::COLOR_BGR2HSV, {18, 40, 50}, {40, 255, 255}, 2, 1, 0},
+                      Steps{"hsv", cv::COLOR_BGR2HSV, {18, 40, 50}, {40, 255, 255}, 0, 0, 0},
+                      Steps{"hsv", cv::COLOR_BGR2HSV, {15, 30, 40}, {45, 255, 255}, 3, 2, 60},
+                      Steps{"lab", cv::COLOR_BGR2Lab, {50, 110, 140}, {255, 132, 255}, 1, 1, 0},
+                      Steps{"bgr", -1, {0, 140, 160}, {255, 255, 255}, 5, 0, 30}),
+    [](const auto& info) {
+      const Steps& steps = info.param;
+      return steps.space + "_dilation" + std::to_string(steps.dilation_px) + "_speckle" +
+             std::to_string(steps.speckle_px) + "_min" + std::to_string(steps.min_value);
+    });
 
 TEST(ColorThreshold, ReusesOutputBuffersNoOneHolds) {
   Scene scene;

@@ -1,0 +1,133 @@
+#include "rank_selection.h"
+
+#include <algorithm>
+#include <numeric>
+#include <utility>
+
+#include <opencv2/core/hal/intrin.hpp>
+
+namespace tilth::estimation {
+namespace {
+
+// Fine enough that a bin holds a small share of a frame's soil depths, small enough that
+// the counts stay in the L1 cache.
+constexpr std::size_t kBins = 4096;
+// Values counted into separate histograms in turn, so that runs of values in one bin do
+// not wait for each other's increments.
+constexpr std::size_t kHistograms = 4;
+constexpr int kLanes = 4;  // cv::v_float32x4
+
+std::pair<float, float> range(std::span<const float> values) {
+  std::size_t i = 0;
+  float lowest = values[0];
+  float highest = values[0];
+  if (values.size() >= kLanes) {
+    cv::v_float32x4 low = cv::v_load(values.data());
+    cv::v_float32x4 high = low;
+    for (i = kLanes; i + kLanes <= values.size(); i += kLanes) {
+      const cv::v_float32x4 value = cv::v_load(values.data() + i);
+      low = cv::v_min(low, value);
+      high = cv::v_max(high, value);
+    }
+    lowest = cv::v_reduce_min(low);
+    highest = cv::v_reduce_max(high);
+  }
+  for (; i < values.size(); ++i) {
+    lowest = std::min(lowest, values[i]);
+    highest = std::max(highest, values[i]);
+  }
+  return {lowest, highest};
+}
+
+}  // namespace
+
+void RankSelection::index(std::span<const float> values) {
+  values_ = values;
+  below_bin_.assign(kBins + 1, 0);
+  if (values.empty()) return;
+  const std::size_t count = values.size();
+  bin_of_value_.resize(count);
+  const auto [lowest, highest] = range(values);
+  // Each step (subtract, scale, clamp, truncate) is monotone, so a larger value never
+  // lands in an earlier bin: the values of rank k lie in the bin where the counts say.
+  // Float overflow only makes a difference infinite, which the clamp takes to the last bin.
+  const auto scale = static_cast<float>(
+      highest > lowest ? kBins / (static_cast<double>(highest) - static_cast<double>(lowest))
+                       : 0.0);
+  const auto last_bin = static_cast<float>(kBins - 1);
+  const auto bin_of = [&](float value) {
+    return static_cast<std::uint16_t>(std::min((value - lowest) * scale, last_bin));
+  };
+  std::size_t i = 0;
+  const cv::v_float32x4 low = cv::v_setall_f32(lowest);
+  const cv::v_float32x4 factor = cv::v_setall_f32(scale);
+  const cv::v_float32x4 last = cv::v_setall_f32(last_bin);
+  const auto bins_of = [&](std::size_t first) {
+    return cv::v_trunc(cv::v_min((cv::v_load(values.data() + first) - low) * factor, last));
+  };
+  for (; i + 2 * kLanes <= count; i += 2 * kLanes) {
+    const cv::v_int16x8 bins = cv::v_pack(bins_of(i), bins_of(i + kLanes));  // < 4096: exact
+    cv::v_store(bin_of_value_.data() + i, cv::v_reinterpret_as_u16(bins));
+  }
+  for (; i < count; ++i) bin_of_value_[i] = bin_of(values[i]);
+
+  counts_.assign(kHistograms * kBins, 0);
+  const std::uint16_t* bins = bin_of_value_.data();
+  for (i = 0; i + kHistograms <= count; i += kHistograms) {
+    for (std::size_t h = 0; h < kHistograms; ++h) ++counts_[h * kBins + bins[i + h]];
+  }
+  for (; i < count; ++i) ++counts_[bins[i]];
+  for (std::size_t bin = 0; bin < kBins; ++bin) {
+    std::uint32_t in_bin = 0;
+    for (std::size_t h = 0; h < kHistograms; ++h) in_bin += counts_[h * kBins + bin];
+    below_bin_[bin + 1] = below_bin_[bin] + in_bin;
+  }
+}
+
+std::size_t RankSelection::gather_bin_of_rank(std::size_t k) {
+  const auto bin = static_cast<std::size_t>(
+      std::upper_bound(below_bin_.begin(), below_bin_.end(), k) - below_bin_.begin() - 1);
+  // Eight values' bins are compared at once; only groups with one in the bin are gathered,
+  // without a branch per value: each is stored, and the count moves on past the bin's own.
+  // One slot more for the last store.
+  candidates_.resize(below_bin_[bin + 1] - below_bin_[bin] + 1);
+  const std::uint16_t* bins = bin_of_value_.data();
+  const auto wanted = static_cast<std::uint16_t>(bin);
+  const cv::v_uint16x8 wanted8 = cv::v_setall_u16(wanted);
+  std::size_t count = 0;
+  const auto gather = [&](std::size_t first, std::size_t end) {
+    for (std::size_t i = first; i < end; ++i) {
+      candidates_[count] = values_[i];
+      count += bins[i] == wanted ? 1 : 0;
+    }
+  };
+  std::size_t i = 0;
+  for (; i + 8 <= values_.size(); i += 8) {
+    if (cv::v_check_any(cv::v_load(bins + i) == wanted8)) gather(i, i + 8);
+  }
+  gather(i, values_.size());
+  return bin;
+}
+
+float RankSelection::at_rank(std::size_t k) {
+  const std::size_t bin = gather_bin_of_rank(k);
+  const auto end = candidates_.end() - 1;
+  const auto kth = candidates_.begin() + static_cast<std::ptrdiff_t>(k - below_bin_[bin]);
+  std::nth_element(candidates_.begin(), kth, end);
+  return *kth;
+}
+
+double RankSelection::sum_of_smallest(std::size_t k) {
+  if (k == 0) return 0.0;
+  const std::size_t bin = gather_bin_of_rank(k - 1);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < values_.size(); ++i) {
+    sum += bin_of_value_[i] < bin ? static_cast<double>(values_[i]) : 0.0;
+  }
+  const auto end = candidates_.end() - 1;
+  const auto last = candidates_.begin() + static_cast<std::ptrdiff_t>(k - 1 - below_bin_[bin]);
+  std::nth_element(candidates_.begin(), last, end);
+  return std::accumulate(candidates_.begin(), last + 1, sum);
+}
+
+}  // namespace tilth::estimation

@@ -1,0 +1,91 @@
+// segmentation.fusion: colour and height together, for residue whose colour is close to
+// the soil's (wet, dark, weathered straw; shadows) and soil the colour alone cannot vouch
+// for.
+//
+//   color ──► colour index, Otsu (as segmentation.color_index) ──► colour says residue ─┐
+//     └──► colour says soil ──► supports the soil surface                             ├─► OR ─►
+//   depth ──► height above the surface (as segmentation.depth_aided) > height_mm ─────┘ despeckle,
+//                                                                                    dilate ─► mask
+//
+// Invariant: one cue is enough for residue, both are needed for soil. A residue pixel
+// taken for soil biases the distance by the residue's height; a soil pixel taken for
+// residue only costs visible soil. So a pixel is soil only when its colour is trusted and
+// on the soil side, it has depth, and it lies no more than height_mm above the surface;
+// it is unknown when either cue is missing (untrusted colour or no depth), and residue
+// when either cue says so.
+//
+//   "segment": {"type": "segmentation.fusion", "params": {"index": "exg", "height_mm": 3}}
+#include <opencv2/core.hpp>
+
+#include "one_material_notice.h"
+#include "residue_index.h"
+#include "residue_output.h"
+#include "soil_surface.h"
+#include "tilth/plugin.h"
+#include "variants.h"
+
+namespace tilth::segmentation {
+namespace {
+
+class Fusion final : public Transform {
+ public:
+  explicit Fusion(const StageContext& context)
+      : index_(parse_color_index(context.params.string("index")),
+               static_cast<int>(context.params.integer("smoothing_px"))),
+        min_value_(static_cast<int>(context.params.integer("min_value"))),
+        height_mm_(context.params.number("height_mm")),
+        surface_(height_mm_, context.params.number("surface_px")),
+        output_(context.params),
+        notice_(context.log) {}
+
+  void process(Frame& frame) override {
+    const auto& color = frame.input<RegisteredColor>(kColorInput);
+    const auto& depth = frame.input<DepthImage>(kDepthInput);
+    check_residue_inputs(color, depth);
+
+    thread_local cv::Mat untrusted, missing, unknown, by_color, soil_color, height, by_height;
+    mark_untrusted_color(color, min_value_, untrusted);
+    mark_missing_depth(depth.mm, missing);
+    cv::bitwise_or(untrusted, missing, unknown);
+
+    const IndexSplit split = index_.classify(color.bgr, untrusted, by_color);
+    notice_.report(frame.info().frame_id, !split.two_classes, split.text());
+    cv::subtract(by_color, untrusted, by_color);
+    cv::bitwise_or(by_color, unknown, soil_color);
+    cv::bitwise_not(soil_color, soil_color);
+
+    surface_.heights(depth.mm, missing, soil_color, height);
+    cv::compare(height, height_mm_, by_height, cv::CMP_GT);  // NaN: no
+    cv::bitwise_or(by_color, by_height, by_color);
+    output_.emit(frame, by_color, cv::Mat(), unknown, depth.mm);
+  }
+
+ private:
+  const ResidueIndex index_;
+  const int min_value_;
+  const double height_mm_;
+  const SoilSurface surface_;
+  ResidueOutput output_;
+  OneMaterialNotice notice_;
+};
+
+}  // namespace
+
+StageDescriptor describe_fusion() {
+  StageDescriptor d;
+  d.type = "segmentation.fusion";
+  d.summary = "residue mask from colour OR height above the soil surface; soil needs both";
+  d.inputs = residue_inputs();
+  d.outputs = residue_outputs();
+  d.params = {
+      color_index_param(), smoothing_px_param(), height_mm_param(), surface_px_param(),
+      dilation_px_param(), speckle_px_param(1),  min_value_param(),
+  };
+  d.concurrency = Concurrency::kParallel;
+  d.create = factory<Fusion>();
+  return d;
+}
+
+TILTH_STAGE(describe_fusion());
+
+}  // namespace tilth::segmentation

@@ -1,0 +1,153 @@
+#include "residue_index.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "otsu.h"
+#include "tilth/error.h"
+
+namespace tilth::segmentation {
+namespace {
+
+constexpr int kBins = 256;
+
+// Histogram range (values outside are counted in the end bins), which side residue is
+// on, the absolute boundary for frames of one material, and the least gap between
+// Otsu's class means that still counts as two materials. docs/segmentation.md derives
+// them from the reference colours and the simulator.
+struct IndexInfo {
+  const char* name;
+  float low;
+  float high;
+  bool residue_above;
+  float boundary;
+  float min_gap;
+};
+
+constexpr std::array<IndexInfo, 4> kIndices{{
+    {"exg", -0.5f, 0.5f, true, 0.02f, 0.05f},
+    {"exr", -0.5f, 1.0f, false, 0.27f, 0.035f},
+    {"exgr", -1.5f, 0.5f, true, -0.19f, 0.1f},
+    {"hue", -60.0f, 120.0f, true, 36.0f, 9.0f},
+}};
+
+const IndexInfo& info(ColorIndex index) { return kIndices[static_cast<int>(index)]; }
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// One pixel's index from its (summed) B, G, R; NaN for black, and for grey in the hue
+// index.
+template <ColorIndex kIndex>
+float index_of(float b, float g, float r) {
+  const float sum = b + g + r;
+  if (sum <= 0) return kNaN;
+  if constexpr (kIndex == ColorIndex::kExg) return (2 * g - r - b) / sum;
+  if constexpr (kIndex == ColorIndex::kExr) return (1.4f * r - g) / sum;
+  if constexpr (kIndex == ColorIndex::kExgr) return (3 * g - 2.4f * r - b) / sum;
+  // HSV hue in degrees, with red-magenta (above 300) taken as negative so that the
+  // reds and browns of soil stay next to the yellows of straw: -60 .. 300.
+  const float high = std::max({b, g, r});
+  const float delta = high - std::min({b, g, r});
+  if (delta <= 0) return kNaN;
+  if (high == r) return 60 * (g - b) / delta;
+  if (high == g) return 60 * ((b - r) / delta + 2);
+  return 60 * ((r - g) / delta + 4);
+}
+
+// Writes each pixel's index and counts the trusted ones into the histogram.
+template <ColorIndex kIndex>
+void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const IndexInfo& range,
+                         cv::Mat& index, std::array<double, kBins>& histogram) {
+  const float bins_per_unit = kBins / (range.high - range.low);
+  for (int row = 0; row < summed.rows; ++row) {
+    const auto* in = summed.ptr<cv::Vec3w>(row);
+    const auto* skip = untrusted.ptr<std::uint8_t>(row);
+    auto* out = index.ptr<float>(row);
+    for (int col = 0; col < summed.cols; ++col) {
+      const float value = index_of<kIndex>(in[col][0], in[col][1], in[col][2]);
+      out[col] = value;
+      if (skip[col] != 0 || std::isnan(value)) continue;
+      const int bin = static_cast<int>((value - range.low) * bins_per_unit);
+      ++histogram[std::clamp(bin, 0, kBins - 1)];
+    }
+  }
+}
+
+}  // namespace
+
+ColorIndex parse_color_index(const std::string& name) {
+  for (std::size_t i = 0; i < kIndices.size(); ++i) {
+    if (name == kIndices[i].name) return static_cast<ColorIndex>(i);
+  }
+  throw Error("parameter 'index': expected one of 'exg', 'exr', 'exgr', 'hue', got '" + name + "'");
+}
+
+std::vector<std::string> color_index_names() {
+  std::vector<std::string> names;
+  for (const auto& index : kIndices) names.emplace_back(index.name);
+  return names;
+}
+
+ResidueIndex::ResidueIndex(ColorIndex index, int smoothing_px)
+    : index_(index), smoothing_px_(smoothing_px) {}
+
+IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
+                                  cv::Mat& residue) const {
+  const IndexInfo& range = info(index_);
+  const float bins_per_unit = kBins / (range.high - range.low);
+
+  // Unnormalised: an index is a ratio of channels, so the box's sum will do (49 * 255
+  // fits in 16 bits).
+  thread_local cv::Mat summed, index;
+  const int side = 2 * smoothing_px_ + 1;
+  cv::boxFilter(bgr, summed, CV_16U, {side, side}, {-1, -1}, false, cv::BORDER_REFLECT);
+  index.create(bgr.size(), CV_32FC1);
+  std::array<double, kBins> histogram{};
+  switch (index_) {
+    case ColorIndex::kExg:
+      index_and_histogram<ColorIndex::kExg>(summed, untrusted, range, index, histogram);
+      break;
+    case ColorIndex::kExr:
+      index_and_histogram<ColorIndex::kExr>(summed, untrusted, range, index, histogram);
+      break;
+    case ColorIndex::kExgr:
+      index_and_histogram<ColorIndex::kExgr>(summed, untrusted, range, index, histogram);
+      break;
+    case ColorIndex::kHue:
+      index_and_histogram<ColorIndex::kHue>(summed, untrusted, range, index, histogram);
+      break;
+  }
+
+  IndexSplit split;
+  split.threshold = range.boundary;
+  split.min_gap = range.min_gap;
+  if (const auto otsu = otsu_split(histogram)) {
+    split.class_gap = static_cast<float>(otsu->upper_mean - otsu->lower_mean) / bins_per_unit;
+    if (split.class_gap >= range.min_gap) {
+      split.two_classes = true;
+      split.threshold = range.low + static_cast<float>(otsu->threshold_bin) / bins_per_unit;
+    }
+  }
+  // NaN compares false: no colour, no residue.
+  cv::compare(index, split.threshold, residue, range.residue_above ? cv::CMP_GE : cv::CMP_LT);
+  return split;
+}
+
+std::string IndexSplit::text() const {
+  char text[64];
+  std::snprintf(text, sizeof text, "class gap %.3g, two materials from %.3g", class_gap, min_gap);
+  return text;
+}
+
+ParamSpec color_index_param() {
+  return ParamSpec::choice("index", color_index_names(), "exg")
+      .describe(
+          "exg = 2g-r-b, exr = 1.4r-g (chromaticities r, g, b), exgr = exg-exr, or hue (deg)");
+}
+
+}  // namespace tilth::segmentation

@@ -1,0 +1,128 @@
+#include "residue_output.h"
+
+#include <limits>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "tilth/error.h"
+
+namespace tilth::segmentation {
+namespace {
+
+std::string size_text(const cv::Mat& image) {
+  return std::to_string(image.cols) + "x" + std::to_string(image.rows);
+}
+
+cv::Mat square_kernel(std::int64_t radius_px) {
+  const int side = 2 * static_cast<int>(radius_px) + 1;
+  return cv::getStructuringElement(cv::MORPH_RECT, {side, side});
+}
+
+}  // namespace
+
+std::vector<PortSpec> residue_inputs() {
+  return {
+      PortSpec::of<RegisteredColor>("color", "colour on the depth grid, with per-pixel status"),
+      PortSpec::of<DepthImage>("depth", "depth in mm, NaN where none"),
+  };
+}
+
+std::vector<PortSpec> residue_outputs() {
+  return {
+      PortSpec::of<ResidueMask>("mask", "255 residue (dilated), 0 soil, 128 unknown"),
+      PortSpec::of<DepthImage>("soil_depth", "depth where the mask says soil, NaN elsewhere"),
+  };
+}
+
+void check_residue_inputs(const RegisteredColor& color, const DepthImage& depth) {
+  if (depth.mm.type() != CV_32FC1) {
+    throw Error("input 'depth': expected a CV_32FC1 image in mm, got type " +
+                std::to_string(depth.mm.type()));
+  }
+  if (color.bgr.type() != CV_8UC3 || color.status.type() != CV_8UC1) {
+    throw Error("input 'color': expected bgr CV_8UC3 and status CV_8UC1, got types " +
+                std::to_string(color.bgr.type()) + " and " + std::to_string(color.status.type()));
+  }
+  if (color.bgr.size() != depth.mm.size() || color.status.size() != depth.mm.size()) {
+    throw Error("input 'color': bgr " + size_text(color.bgr) + " and status " +
+                size_text(color.status) + " do not match the " + size_text(depth.mm) +
+                " depth image (expected colour registered onto the depth grid)");
+  }
+}
+
+ParamSpec dilation_px_param() {
+  return ParamSpec::integer("dilation_px", 2)
+      .range(0, 32)
+      .in_unit("px")
+      .describe("pixels within this distance of residue are residue too; 0 = no dilation");
+}
+
+ParamSpec speckle_px_param(std::int64_t default_px) {
+  return ParamSpec::integer("speckle_px", default_px)
+      .range(0, 8)
+      .in_unit("px")
+      .describe(
+          "residue narrower than 2*speckle_px+1 px is dropped before dilation "
+          "(noise, demosaicing specks); 0 = keep all");
+}
+
+ParamSpec smoothing_px_param() {
+  return ParamSpec::integer("smoothing_px", 1)
+      .range(0, 3)
+      .in_unit("px")
+      .describe("colours are averaged over a (2r+1)^2 box first; 0 = each pixel's own");
+}
+
+ParamSpec min_value_param() {
+  return ParamSpec::integer("min_value", 0)
+      .range(0, 255)
+      .describe("pixels whose brightest channel is below this are unknown (deep shadow)");
+}
+
+void mark_untrusted_color(const RegisteredColor& color, int min_value, cv::Mat& untrusted) {
+  cv::compare(color.status, RegisteredColor::kValid, untrusted, cv::CMP_NE);
+  if (min_value == 0) return;
+  thread_local cv::Mat dark;
+  cv::inRange(color.bgr, cv::Scalar::all(0), cv::Scalar::all(min_value - 1), dark);
+  cv::bitwise_or(untrusted, dark, untrusted);
+}
+
+void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing) {
+  // Also true for NaN, which compares false with everything.
+  cv::compare(depth_mm, 0.0, missing, cv::CMP_GT);
+  cv::bitwise_not(missing, missing);
+}
+
+ResidueOutput::ResidueOutput(const Params& params)
+    : dilation_px_(static_cast<int>(params.integer("dilation_px"))),
+      kernel_(square_kernel(dilation_px_)),
+      speckle_kernel_(square_kernel(params.integer("speckle_px"))),
+      despeckle_(params.integer("speckle_px") > 0) {}
+
+void ResidueOutput::emit(Frame& frame, cv::Mat& residue, const cv::Mat& not_residue,
+                         const cv::Mat& unknown, const cv::Mat& depth_mm) {
+  auto mask = masks_.acquire();
+  auto soil = soil_depths_.acquire();
+  reuse_or_create(mask->values, depth_mm.rows, depth_mm.cols, CV_8UC1);
+  reuse_or_create(soil->mm, depth_mm.rows, depth_mm.cols, CV_32FC1);
+
+  if (!not_residue.empty()) cv::subtract(residue, not_residue, residue);  // 255 - 255 = 0
+  if (despeckle_) cv::morphologyEx(residue, residue, cv::MORPH_OPEN, speckle_kernel_);
+  if (dilation_px_ > 0) {
+    cv::dilate(residue, mask->values, kernel_);
+  } else {
+    residue.copyTo(mask->values);
+  }
+  mask->values.setTo(ResidueMask::kUnknown, unknown);
+
+  thread_local cv::Mat soil_pixels;
+  cv::compare(mask->values, ResidueMask::kSoil, soil_pixels, cv::CMP_EQ);
+  soil->mm.setTo(std::numeric_limits<float>::quiet_NaN());
+  depth_mm.copyTo(soil->mm, soil_pixels);
+
+  frame.set_output(kMask, mask);
+  frame.set_output(kSoilDepth, soil);
+}
+
+}  // namespace tilth::segmentation

@@ -1,0 +1,68 @@
+// What every residue segmentation stage shares with segmentation.color_threshold, so that
+// a graph swaps them by type name: the ports, the input checks, the parameters of the last
+// steps, and those steps from a raw residue decision to the outputs (speck removal,
+// dilation, unknowns, soil depth).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "tilth/frame.h"
+#include "tilth/message_pool.h"
+#include "tilth/messages/depth_image.h"
+#include "tilth/messages/registered_color.h"
+#include "tilth/messages/residue_mask.h"
+#include "tilth/param_spec.h"
+#include "tilth/params.h"
+#include "tilth/port_spec.h"
+
+namespace tilth::segmentation {
+
+enum ResidueInputPort { kColorInput = 0, kDepthInput = 1 };
+
+std::vector<PortSpec> residue_inputs();   // color (RegisteredColor), depth (DepthImage)
+std::vector<PortSpec> residue_outputs();  // mask (ResidueMask), soil_depth (DepthImage)
+
+// Throws tilth::Error naming the input and what was expected: types, and colour registered
+// onto the depth grid.
+void check_residue_inputs(const RegisteredColor& color, const DepthImage& depth);
+
+ParamSpec dilation_px_param();
+ParamSpec speckle_px_param(std::int64_t default_px);
+ParamSpec min_value_param();
+ParamSpec smoothing_px_param();  // colours averaged over a (2r+1)^2 box first
+
+// 255 where the colour cannot be used: status not kValid, or every channel below min_value.
+void mark_untrusted_color(const RegisteredColor& color, int min_value, cv::Mat& untrusted);
+
+// 255 where the depth is NaN or not beyond the mounting surface (<= 0 mm), which no
+// surface in front of the camera gives.
+void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing);
+
+class ResidueOutput {
+ public:
+  enum OutputPort { kMask = 0, kSoilDepth = 1 };
+
+  // Reads dilation_px and speckle_px.
+  explicit ResidueOutput(const Params& params);
+
+  // `residue` (CV_8UC1, 255/0) is what the variant found, and is consumed. Pixels marked
+  // in `not_residue` (if not empty) are taken out of it first, so they cannot grow into their
+  // neighbours; specks narrower than 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels
+  // marked in `unknown` become kUnknown; the depth of the remaining soil pixels is the
+  // soil depth. Sets both outputs of `frame`.
+  void emit(Frame& frame, cv::Mat& residue, const cv::Mat& not_residue, const cv::Mat& unknown,
+            const cv::Mat& depth_mm);
+
+ private:
+  const int dilation_px_;
+  const cv::Mat kernel_;
+  const cv::Mat speckle_kernel_;
+  const bool despeckle_;
+  MessagePool<ResidueMask> masks_;
+  MessagePool<DepthImage> soil_depths_;
+};
+
+}  // namespace tilth::segmentation

@@ -1,0 +1,162 @@
+// Every segmentation variant on frames of the scene simulator (rendered, projected and
+// registered in process), against the simulator's ground truth: mask IoU, and the ground
+// distance the paper's estimator would report from the soil depth (the median in the
+// middle half of the image). The thresholds are the measured figures with a margin; the
+// comments give the measurements (docs/segmentation.md has the full table).
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "classifier_model.h"
+#include "segmenter_training.h"
+#include "simulated_frames.h"
+#include "stage_harness.h"
+#include "temp_dir.h"
+#include "tilth/messages/residue_mask.h"
+#include "variants.h"
+
+namespace tilth::segmentation {
+namespace {
+
+using nlohmann::json;
+using train_segmenter::RegisteredFrame;
+
+constexpr int kFrames = 2;
+
+struct Outcome {
+  double iou = 1;            // worst frame: residue IoU of the undilated mask
+  double error_mm = 0;       // worst frame: |estimated - true distance|, when measurable
+  double soil_fraction = 1;  // least soil fraction of the region of interest
+};
+
+// The region of interest of estimation.ground_distance: the middle half in each direction.
+cv::Rect middle_half(const cv::Size& size) {
+  return {size.width / 4, size.height / 4, size.width / 2, size.height / 2};
+}
+
+double median_depth(const cv::Mat& soil_mm, std::size_t& count) {
+  std::vector<float> depths;
+  for (int row = 0; row < soil_mm.rows; ++row) {
+    for (int col = 0; col < soil_mm.cols; ++col) {
+      const float depth = soil_mm.at<float>(row, col);
+      if (!std::isnan(depth)) depths.push_back(depth);
+    }
+  }
+  count = depths.size();
+  if (depths.empty()) return std::nan("");
+  std::sort(depths.begin(), depths.end());
+  const std::size_t half = depths.size() / 2;
+  return depths.size() % 2 ? depths[half] : 0.5 * (depths[half - 1] + depths[half]);
+}
+
+Outcome evaluate(const std::string& name, const StageDescriptor& stage, const json& params,
+                 const std::vector<RegisteredFrame>& frames) {
+  json undilated = params;
+  undilated["dilation_px"] = 0;
+  testing::TransformHarness classify(stage, undilated);
+  testing::TransformHarness measure(stage, params);
+  Outcome outcome;
+  for (const RegisteredFrame& frame : frames) {
+    const cv::Mat& truth = frame.truth->residue_mask;
+    const auto classified = classify.run({frame.color, frame.depth}, frame.frame_id);
+    const cv::Mat& mask = classified[0].get<ResidueMask>().values;
+    const cv::Mat judged = (truth != ResidueMask::kUnknown) & (mask != ResidueMask::kUnknown);
+    const cv::Mat said = mask == ResidueMask::kResidue;
+    const cv::Mat is = truth == ResidueMask::kResidue;
+    const int both = cv::countNonZero(said & is & judged);
+    const int either = cv::countNonZero((said | is) & judged);
+    const double iou = either == 0 ? 1.0 : static_cast<double>(both) / either;
+
+    const auto measured = measure.run({frame.color, frame.depth}, frame.frame_id);
+    const cv::Mat soil = measured[1].get<DepthImage>().mm(middle_half(truth.size()));
+    std::size_t count = 0;
+    const double distance = median_depth(soil, count);
+    const double fraction = static_cast<double>(count) / static_cast<double>(soil.total());
+    outcome.iou = std::min(outcome.iou, iou);
+    outcome.soil_fraction = std::min(outcome.soil_fraction, fraction);
+    if (count > 0) {
+      outcome.error_mm = std::max(outcome.error_mm, std::abs(distance - *frame.truth->distance_mm));
+    }
+  }
+  std::cout << "  " << name << ": IoU " << outcome.iou << ", |error| " << outcome.error_mm
+            << " mm, soil " << outcome.soil_fraction << "\n";
+  return outcome;
+}
+
+Outcome color_index(const std::vector<RegisteredFrame>& frames) {
+  return evaluate("color_index", describe_color_index(), json::object(), frames);
+}
+Outcome lab_clusters(const std::vector<RegisteredFrame>& frames) {
+  return evaluate("lab_clusters", describe_lab_clusters(), json::object(), frames);
+}
+Outcome depth_aided(const std::vector<RegisteredFrame>& frames) {
+  return evaluate("depth_aided", describe_depth_aided(), json::object(), frames);
+}
+Outcome fusion(const std::vector<RegisteredFrame>& frames) {
+  return evaluate("fusion", describe_fusion(), json::object(), frames);
+}
+
+// Below this fraction of soil in the region of interest estimation.ground_distance
+// reports no valid measurement (its min_soil_fraction).
+constexpr double kMinSoilFraction = 0.05;
+
+// Paper case C: 150 dry straws and stubble. Every variant finds the straw (IoU 0.95-0.97
+// measured; 0.92 for the depth-only variant, which misses the low flanks of round straws)
+// and the distance within 0.04 mm: the bound of 0.15 mm leaves room for noise and is
+// still a fifth of what wet straw costs a colour-only variant (below).
+TEST(SimulatedCaseC, EveryVariantFindsTheStrawAndTheDistance) {
+  const auto frames = simulated_frames("case_c", 1, kFrames);
+  for (const Outcome& outcome : {color_index(frames), lab_clusters(frames), fusion(frames)}) {
+    EXPECT_GT(outcome.iou, 0.93);
+    EXPECT_LT(outcome.error_mm, 0.15);
+    EXPECT_GT(outcome.soil_fraction, 0.4);
+  }
+  const Outcome by_depth = depth_aided(frames);
+  EXPECT_GT(by_depth.iou, 0.9);
+  EXPECT_LT(by_depth.error_mm, 0.15);
+
+  // The classifier, trained on frames of another seed (other straws, other noise).
+  train_segmenter::TrainingSet training;
+  for (const RegisteredFrame& frame : simulated_frames("case_c", 2, kFrames)) {
+    training.sample(frame, 2000, frame.frame_id + 1);
+  }
+  testing::TempDir temp;
+  const auto model = temp.path() / "case_c.yml.gz";
+  write_classifier_model(model, *training.train(30, 12), "case_c seed 2");
+  const Outcome learnt = evaluate("pixel_classifier", describe_pixel_classifier(),
+                                  {{"model", model.string()}}, frames);
+  EXPECT_GT(learnt.iou, 0.94);
+  EXPECT_LT(learnt.error_mm, 0.15);
+}
+
+// 150 dark, wet straws whose colour is the soil's: colour alone takes them for soil
+// (IoU 0.05) and their tops pull the distance 0.73 mm short; their height gives them away
+// (IoU 0.92-0.93, error 0.04 mm).
+TEST(SimulatedWetStraw, HeightFindsWhatColourMisses) {
+  const auto frames = simulated_frames("wet_straw", 1, kFrames);
+  const Outcome by_colour = color_index(frames);
+  EXPECT_LT(by_colour.iou, 0.2);
+  EXPECT_GT(by_colour.error_mm, 0.5);
+  for (const Outcome& outcome : {depth_aided(frames), fusion(frames)}) {
+    EXPECT_GT(outcome.iou, 0.9);
+    EXPECT_LT(outcome.error_mm, 0.15);
+  }
+}
+
+// 1000 wet straws piled up to 250 mm, under 2 % of the soil in view: colour calls two
+// thirds of the soil-coloured pile soil and would measure it (171 mm short); height
+// leaves under 1 % "soil", too little for a measurement, as it must.
+TEST(SimulatedCoveredWet, NoMeasurementFromAPileOfSoilColouredStraw) {
+  const auto frames = simulated_frames("covered_wet", 1, kFrames);
+  EXPECT_GT(color_index(frames).soil_fraction, 0.5);
+  for (const Outcome& outcome : {depth_aided(frames), fusion(frames)}) {
+    EXPECT_LT(outcome.soil_fraction, kMinSoilFraction);
+  }
+}
+
+}  // namespace
+}  // namespace tilth::segmentation
