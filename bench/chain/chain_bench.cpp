@@ -167,11 +167,14 @@ void run(benchmark::State& state, const char* color_format, Chain::Step step) {
   Chain chain(color_format);
   for (int warm_up = 0; warm_up < 3; ++warm_up) chain.run(Chain::kWhole);
   if (step != Chain::kWhole) {
-    // Keep the inputs of the measured stage: run the chain up to it once more, and the
-    // stage once more, so that its pool holds the message the next frame writes into.
-    for (int before = Chain::kProject; before <= step; ++before) {
+    // Keep the inputs of the measured stage: run the chain up to it once more. Then the
+    // stage twice: its output is held from one frame to the next, so its pool needs a
+    // second message, made here rather than in the measured loop.
+    for (int before = Chain::kProject; before < step; ++before) {
       chain.run(static_cast<Chain::Step>(before));
     }
+    chain.run(step);
+    chain.run(step);
   }
 
   CountingMatAllocator counting;

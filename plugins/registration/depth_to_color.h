@@ -5,7 +5,6 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -32,24 +31,6 @@ class DepthToColor {
   void project_row(int row, const float* z_mm, float* color_u, float* color_v,
                    float* color_depth) const;
 
-  // The z-buffer's grid over the colour image: square cells of `size` pixels, `columns`
-  // to a row.
-  struct CellGrid {
-    int size;
-    int columns;
-  };
-
-  // As project_row, for the registration's first pass: the nearest colour pixel as its
-  // index y * width + x, its cell (cell_y * columns + cell_x), both -1 where the colour
-  // image does not show the point, and the depth along the colour axis (meaningful only
-  // where shown). Indices are computed in float: the colour image must have fewer than
-  // 2^24 pixels and a side below 2^16.
-  void locate_row(int row, const float* z_mm, const CellGrid& cells, std::int32_t* color_pixel,
-                  std::int32_t* cell, float* color_depth) const;
-  // The depth along the colour axis alone, bit for bit as locate_row gives it, for the
-  // second pass: a few multiply-adds per pixel, cheaper than keeping it from the first.
-  void color_depth_row(int row, const float* z_mm, float* color_depth) const;
-
   int row_capacity() const { return row_capacity_; }  // depth width, whole SIMD vectors
   int depth_width() const { return depth_width_; }
   int depth_height() const { return depth_height_; }
@@ -57,12 +38,9 @@ class DepthToColor {
   int color_height() const { return color_height_; }
 
  private:
-  using Row3 = std::array<float, 3>;
-
-  template <class Store>
-  void project(int row, const float* z_mm, const Store& store) const;
-  template <bool kSeparable, bool kDistorted, class Store>
-  void project(int row, const float* z_mm, const Store& store) const;
+  template <bool kSeparable, bool kDistorted>
+  void project(int row, const float* z_mm, float* color_u, float* color_v,
+               float* color_depth) const;
 
   int depth_width_;
   int depth_height_;
@@ -76,16 +54,10 @@ class DepthToColor {
   bool separable_;
   std::vector<float> x_;
   std::vector<float> y_;
-  std::array<Row3, 3> r_;
+  std::array<float, 9> r_;  // row-major
   std::array<float, 3> t_mm_;
-  // Without colour distortion: rows that take a point's P_d to (u + 0.5) Z and (v + 0.5) Z,
-  // and the T parts of those.
-  Row3 u_numerator_;
-  Row3 v_numerator_;
-  float u_numerator_t_;
-  float v_numerator_t_;
   float z_offset_mm_;
-  float fx_, fy_, cx_half_, cy_half_;  // cx + 0.5, cy + 0.5: see project()
+  float fx_, fy_, cx_, cy_;
   bool distorted_;
   std::array<float, 5> k_;
   float max_radius2_;  // squared normalised radius of the fold (infinity: none)

@@ -25,8 +25,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -46,9 +44,7 @@
 namespace tilth::registration {
 namespace {
 
-constexpr int kLanes = 4;                                        // cv::v_float32x4
-constexpr std::int64_t kMaxColorPixels = std::int64_t{1} << 24;  // float's exact integers
-constexpr int kMaxColorSide = 1 << 16;
+constexpr int kLanes = 4;  // cv::v_float32x4
 
 std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height) + " px";
@@ -58,7 +54,7 @@ std::string size_text(int width, int height) {
 // pixels of a surface seen by both cameras leave none empty. A depth pixel spans about
 // d = fx_c / fx_d colour pixels, and the samples of a surface form a lattice of spacing d
 // at any rotation, which leaves points up to d / sqrt(2) from the nearest sample: a cell
-// of side sqrt(2) d always holds one. A point's cell is that of its nearest colour pixel.
+// of side sqrt(2) d always holds one.
 struct OcclusionCells {
   explicit OcclusionCells(const RigCalibration& rig)
       : size(static_cast<int>(std::ceil(
@@ -66,69 +62,110 @@ struct OcclusionCells {
         columns((rig.color.width + size - 1) / size),
         rows((rig.color.height + size - 1) / size) {}
 
-  DepthToColor::CellGrid grid() const { return {size, columns}; }
-
   int size;
   int columns;
   int rows;
 };
 
-// What a frame in flight needs besides its output: the z-buffer, each depth pixel's
-// colour pixel and cell (located in the first pass, read in the second), one row of depths
-// along the colour axis (recomputed in the second pass: cheaper than keeping a frame of
-// them), and the colour image as bgr8 when it comes as a Bayer mosaic.
+// One row of located depth pixels, as plain pointers: the registration writes bytes, and
+// through a byte pointer the compiler must assume any memory changed, so everything read
+// per pixel is held in locals, not reached through objects.
+struct LocatedRow {
+  const float* u;  // colour pixel
+  const float* v;
+  const float* depth_mm;  // along the colour axis; NaN: not in the colour image
+  const int* offset;      // of the nearest colour pixel in the colour image, in bytes
+  const int* cell;        // -1: not in the colour image
+};
+
+// What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
+// colour camera sees them (located once, read by both passes), and the demosaiced colour
+// image.
 struct Scratch {
   cv::Mat nearest_mm;  // CV_32FC1 per cell: the nearest depth along the colour axis
-  std::vector<std::int32_t> color_pixel, cell;  // rows of DepthToColor::row_capacity()
-  std::vector<float> color_depth;               // one row
-  std::vector<float> color_u, color_v;          // one row, for bilinear sampling
-  cv::Mat demosaiced;                           // CV_8UC3, from a Bayer mosaic
-  cv::Mat continuous;  // the colour image, when it came with gaps between rows
+  std::vector<float> color_u, color_v, color_depth;  // rows of DepthToColor::row_capacity()
+  std::vector<int> offset, cell;
+  cv::Mat demosaiced;  // CV_8UC3, from a Bayer mosaic
 
   void prepare(const DepthToColor& map, const OcclusionCells& cells) {
-    const auto row = static_cast<std::size_t>(map.row_capacity());
-    for (auto* values : {&color_pixel, &cell}) values->resize(row * map.depth_height());
-    for (auto* values : {&color_depth, &color_u, &color_v}) values->resize(row);
+    const auto n = static_cast<std::size_t>(map.row_capacity()) * map.depth_height();
+    for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(n);
+    for (auto* values : {&offset, &cell}) values->resize(n);
     reuse_or_create(nearest_mm, cells.rows, cells.columns, CV_32FC1);
     // Not Mat::setTo, which allocates a scratch buffer every call.
     std::fill_n(nearest_mm.ptr<float>(), nearest_mm.total(),
                 std::numeric_limits<float>::infinity());
   }
+
+  LocatedRow row(const DepthToColor& map, int v) const {
+    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
+    return {color_u.data() + start, color_v.data() + start, color_depth.data() + start,
+            offset.data() + start, cell.data() + start};
+  }
+
+  // Projects depth row `v` and finds each point's nearest colour pixel (as its byte
+  // offset in an image of `step` bytes per row and `pixel_bytes` per pixel; int32 holds
+  // any image below 2 GB) and its cell.
+  LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                    int v, std::ptrdiff_t step, int pixel_bytes) {
+    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
+    float* const u_row = color_u.data() + start;
+    float* const v_row = color_v.data() + start;
+    float* const depth_row = color_depth.data() + start;
+    int* const offset_row = offset.data() + start;
+    int* const cell_row = cell.data() + start;
+    map.project_row(v, depth.ptr<float>(v), u_row, v_row, depth_row);
+    using cv::v_float32x4;
+    using cv::v_int32x4;
+    const v_float32x4 half = cv::v_setall_f32(0.5f);
+    const v_float32x4 per_cell = cv::v_setall_f32(1.0f / static_cast<float>(cells.size));
+    const v_int32x4 columns = cv::v_setall_s32(cells.columns);
+    const v_int32x4 row_bytes = cv::v_setall_s32(static_cast<int>(step));
+    const v_int32x4 bytes = cv::v_setall_s32(pixel_bytes);
+    const v_int32x4 none = cv::v_setall_s32(-1);
+    for (int i = 0; i < map.row_capacity(); i += kLanes) {
+      // Shown points have 0 <= u + 0.5 < width (DepthToColor::kEdgeMarginPx): truncation
+      // rounds to the nearest pixel, and floor((u + 0.5) / size) is the cell.
+      const v_float32x4 x = cv::v_load(u_row + i) + half;
+      const v_float32x4 y = cv::v_load(v_row + i) + half;
+      const v_float32x4 depth_mm = cv::v_load(depth_row + i);
+      cv::v_store(offset_row + i, cv::v_trunc(y) * row_bytes + cv::v_trunc(x) * bytes);
+      const v_int32x4 index =
+          cv::v_muladd(cv::v_trunc(y * per_cell), columns, cv::v_trunc(x * per_cell));
+      const v_int32x4 shown = cv::v_reinterpret_as_s32(depth_mm == depth_mm);  // not NaN
+      cv::v_store(cell_row + i, cv::v_select(shown, index, none));
+    }
+    return row(map, v);
+  }
 };
 
-struct Bgr {
-  int b, g, r;
-};
-
-Bgr channels(std::uint32_t bgr24) {
-  return {static_cast<int>(bgr24 & 0xFF), static_cast<int>((bgr24 >> 8) & 0xFF),
-          static_cast<int>(bgr24 >> 16)};
-}
-
-// The four colour pixels around (u, v), blended; weights in 1/256.
-template <class Sampler>
-std::uint32_t bilinear(const Sampler& sampler, float u, float v, int height) {
-  const int width = sampler.width();
-  // u, v >= -0.5: truncation of u + 1 is floor(u) + 1.
-  const int x0 = static_cast<int>(u + 1.0f) - 1;
-  const int y0 = static_cast<int>(v + 1.0f) - 1;
-  const int wx = static_cast<int>((u - static_cast<float>(x0)) * 256.0f + 0.5f);
-  const int wy = static_cast<int>((v - static_cast<float>(y0)) * 256.0f + 0.5f);
-  // The neighbours, clamped to the image.
-  const int top_left = std::max(y0, 0) * width + std::max(x0, 0);
-  const int right = x0 >= 0 && x0 + 1 < width ? 1 : 0;
-  const int down = y0 >= 0 && y0 + 1 < height ? width : 0;
-  const Bgr a = channels(sampler.at(top_left));
-  const Bgr b = channels(sampler.at(top_left + right));
-  const Bgr c = channels(sampler.at(top_left + down));
-  const Bgr d = channels(sampler.at(top_left + down + right));
-  const auto blend = [&](int ca, int cb, int cc, int cd) {
-    const int upper = ca * (256 - wx) + cb * wx;
-    const int lower = cc * (256 - wx) + cd * wx;
-    return static_cast<std::uint32_t>((upper * (256 - wy) + lower * wy + (1 << 15)) >> 16);
-  };
-  return blend(a.b, b.b, c.b, d.b) | (blend(a.g, b.g, c.g, d.g) << 8) |
-         (blend(a.r, b.r, c.r, d.r) << 16);
+template <bool kBilinear, class Sampler>
+Bgr sample(const Sampler& sampler, const LocatedRow& row, int i, int width, int height) {
+  if constexpr (!kBilinear) {
+    return sampler.at(row.offset[i]);
+  } else {
+    const float u = row.u[i];
+    const float v = row.v[i];
+    // u, v >= -0.5: truncation of u + 1 is floor(u) + 1. Weights in 1/256.
+    const int x0 = static_cast<int>(u + 1.0f) - 1;
+    const int y0 = static_cast<int>(v + 1.0f) - 1;
+    const int wx = static_cast<int>((u - static_cast<float>(x0)) * 256.0f + 0.5f);
+    const int wy = static_cast<int>((v - static_cast<float>(y0)) * 256.0f + 0.5f);
+    // The neighbours, clamped to the image.
+    const std::ptrdiff_t top_left = sampler.offset(std::max(x0, 0), std::max(y0, 0));
+    const std::ptrdiff_t right = x0 >= 0 && x0 + 1 < width ? Sampler::kPixelBytes : 0;
+    const std::ptrdiff_t down = y0 >= 0 && y0 + 1 < height ? sampler.step() : 0;
+    const Bgr a = sampler.at(top_left);
+    const Bgr b = sampler.at(top_left + right);
+    const Bgr c = sampler.at(top_left + down);
+    const Bgr d = sampler.at(top_left + down + right);
+    const auto blend = [&](int ca, int cb, int cc, int cd) {
+      const int upper = ca * (256 - wx) + cb * wx;
+      const int lower = cc * (256 - wx) + cd * wx;
+      return (upper * (256 - wy) + lower * wy + (1 << 15)) >> 16;
+    };
+    return {blend(a.b, b.b, c.b, d.b), blend(a.g, b.g, c.g, d.g), blend(a.r, b.r, c.r, d.r)};
+  }
 }
 
 template <bool kBilinear, class Sampler>
@@ -136,65 +173,42 @@ void register_frame(const DepthToColor& map, const OcclusionCells& cells, const 
                     const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
                     RegisteredColor& out) {
   scratch.prepare(map, cells);
-  // Everything read per pixel is held in locals: the loops write bytes, and through a
-  // byte pointer the compiler must assume any memory changed.
-  const Sampler colors = sampler;
+  const Sampler colors = sampler;  // a local: see LocatedRow
   float* const nearest_mm = scratch.nearest_mm.ptr<float>();
-  float* const color_depth = scratch.color_depth.data();
-  float* const color_u = scratch.color_u.data();
-  float* const color_v = scratch.color_v.data();
   const int width = map.depth_width();
   const int height = map.depth_height();
+  const int color_width = map.color_width();
   const int color_height = map.color_height();
-  const auto row_start = [&](int v) { return static_cast<std::size_t>(v) * map.row_capacity(); };
 
   for (int v = 0; v < height; ++v) {  // the nearest point of each cell
-    std::int32_t* const pixel = scratch.color_pixel.data() + row_start(v);
-    std::int32_t* const cell = scratch.cell.data() + row_start(v);
-    map.locate_row(v, depth.ptr<float>(v), cells.grid(), pixel, cell, color_depth);
-    // Even pixels, then odd ones: neighbours often share a cell, and each update would
-    // wait for the one before it to reach memory.
-    for (int first = 0; first < 2; ++first) {
-      for (int u = first; u < width; u += 2) {
-        if (cell[u] >= 0) nearest_mm[cell[u]] = std::min(nearest_mm[cell[u]], color_depth[u]);
-      }
+    const LocatedRow row =
+        scratch.locate(map, cells, depth, v, colors.step(), Sampler::kPixelBytes);
+    for (int u = 0; u < width; ++u) {
+      const int cell = row.cell[u];
+      if (cell >= 0) nearest_mm[cell] = std::min(nearest_mm[cell], row.depth_mm[u]);
     }
   }
 
   for (int v = 0; v < height; ++v) {
-    const std::int32_t* const pixel = scratch.color_pixel.data() + row_start(v);
-    const std::int32_t* const cell = scratch.cell.data() + row_start(v);
+    const LocatedRow row = scratch.row(map, v);
     const auto* z = depth.ptr<float>(v);
-    if constexpr (kBilinear) {
-      map.project_row(v, z, color_u, color_v, color_depth);
-    } else {
-      map.color_depth_row(v, z, color_depth);
-    }
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);
-    const auto color_at = [&](int u) -> std::uint32_t {
-      if (cell[u] < 0) {
+    for (int u = 0; u < width; ++u) {
+      Bgr color{0, 0, 0};
+      const int cell = row.cell[u];
+      if (cell < 0) {
         status[u] = std::isnan(z[u]) ? RegisteredColor::kNoDepth : RegisteredColor::kOutsideColor;
-        return 0;
-      }
-      if (color_depth[u] > nearest_mm[cell[u]] + occlusion_tolerance_mm) {
+      } else if (row.depth_mm[u] > nearest_mm[cell] + occlusion_tolerance_mm) {
         status[u] = RegisteredColor::kOccluded;
-        return 0;
+      } else {
+        status[u] = RegisteredColor::kValid;
+        color = sample<kBilinear>(colors, row, u, color_width, color_height);
       }
-      status[u] = RegisteredColor::kValid;
-      return kBilinear ? bilinear(colors, color_u[u], color_v[u], color_height)
-                       : colors.at(pixel[u]);
-    };
-    // Four bytes a pixel, the fourth the next pixel's blue, which its own turn overwrites;
-    // three for the row's last pixel.
-    for (int u = 0; u + 1 < width; ++u) {
-      const std::uint32_t color = color_at(u);
-      std::memcpy(bgr + 3 * u, &color, 4);
+      bgr[3 * u] = static_cast<std::uint8_t>(color.b);
+      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g);
+      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r);
     }
-    const Bgr last = channels(color_at(width - 1));
-    bgr[3 * width - 3] = static_cast<std::uint8_t>(last.b);
-    bgr[3 * width - 2] = static_cast<std::uint8_t>(last.g);
-    bgr[3 * width - 1] = static_cast<std::uint8_t>(last.r);
   }
 }
 
@@ -212,13 +226,6 @@ class ProjectiveRegistration final : public Transform {
     reuse_or_create(out->bgr, map_.depth_height(), map_.depth_width(), CV_8UC3);
     reuse_or_create(out->status, map_.depth_height(), map_.depth_width(), CV_8UC1);
     const auto scratch = scratch_.acquire();
-    // The samplers address pixels by index: a colour image with gaps between its rows
-    // (a region of a larger one) is copied first.
-    const cv::Mat* pixels = &color.pixels;
-    if (!color.pixels.isContinuous()) {
-      color.pixels.copyTo(scratch->continuous);
-      pixels = &scratch->continuous;
-    }
     const auto run = [&](const auto& sampler) {
       if (bilinear_) {
         register_frame<true>(map_, cells_, depth, sampler, occlusion_tolerance_mm_, *scratch, *out);
@@ -230,18 +237,18 @@ class ProjectiveRegistration final : public Transform {
     // OpenCV's SIMD demosaicing of the whole image costs less than demosaicing only the
     // pixels read, one at a time.
     const auto run_demosaiced = [&](int code) {
-      cv::cvtColor(*pixels, scratch->demosaiced, code);
+      cv::cvtColor(color.pixels, scratch->demosaiced, code);
       run(BgrSampler(scratch->demosaiced));
     };
     switch (color.format) {
       case PixelFormat::kBgr8:
-        run(BgrSampler(*pixels));
+        run(BgrSampler(color.pixels));
         break;
       case PixelFormat::kRgb8:
-        run(RgbSampler(*pixels));
+        run(RgbSampler(color.pixels));
         break;
       case PixelFormat::kMono8:
-        run(MonoSampler(*pixels));
+        run(MonoSampler(color.pixels));
         break;
       // OpenCV names a mosaic by its second row's second and third pixels, one pixel
       // off the usual naming by the top-left 2x2 tile.
@@ -271,16 +278,7 @@ class ProjectiveRegistration final : public Transform {
         cells_(rig),
         occlusion_tolerance_mm_(
             static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
-        bilinear_(context.params.string("interpolation") == "bilinear") {
-    // Colour pixel indices are computed in float (DepthToColor::locate_row).
-    if (static_cast<std::int64_t>(rig.color.width) * rig.color.height >= kMaxColorPixels ||
-        rig.color.width >= kMaxColorSide || rig.color.height >= kMaxColorSide) {
-      throw Error(file + ":/color_camera: a colour image of " +
-                  size_text(rig.color.width, rig.color.height) +
-                  " is larger than registration.projective supports (2^24 px, sides below "
-                  "65536)");
-    }
-  }
+        bilinear_(context.params.string("interpolation") == "bilinear") {}
 
   void check(const cv::Mat& depth, const ColorImage& color) const {
     if (depth.type() != CV_32FC1) {

@@ -12,6 +12,11 @@
 // The dilation is what keeps straw edges, and the ToF pixels that mix straw and soil
 // depth along them, out of the soil depth.
 //
+// Per frame the conversion and in-range test are one lookup per pixel in a table of every
+// BGR colour (ColorRangeTable, made when the stage starts with OpenCV's own cvtColor and
+// inRange, so the mask is theirs exactly), and the masks are bits, 64 pixels to a word
+// (BitMask), for the morphology.
+//
 //   "segment": {"type": "segmentation.color_threshold",
 //               "params": {"color_space": "hsv", "residue_lower": [18, 40, 50],
 //                          "residue_upper": [40, 255, 255], "dilation_px": 2}}
@@ -19,10 +24,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <string>
 #include <vector>
 
