@@ -1,16 +1,18 @@
 // mcap.player: replays an MCAP recording that mcap.writer made, as fast as possible or
-// paced by the depth timestamps, optionally only a time window of it.
+// paced by the depth images' device timestamps, optionally only a time window of it.
 //
 //   FILE.mcap ──> mcap.player ──> raw, color, truth
 //
 // Frames are rebuilt from the consecutive messages of a chunk that share a sequence
-// number (the frame id).
-// With a summary, the chunks outside [start_s, end_s] are skipped using the ChunkIndex
-// records without being read; without one (a file cut off mid-write) the chunks found
-// by scanning the file from the start are played and a warning says how much was
-// recovered.
+// number (the frame id), in the order the chunks were written. A frame's device times
+// are its images' timestamps; its host capture time is when it is played, or with
+// host_time: recorded the depth message's log time (for recordings whose log times are
+// device times, the older ones, that is its device time).
+// The window [start_s, end_s] is in log time, Foxglove's timeline. With a summary, the
+// chunks outside it are skipped using the ChunkIndex records without being read; without
+// one (a file cut off mid-write) the chunks found by scanning the file from the start
+// are played and a warning says how much was recovered.
 #include <algorithm>
-#include <chrono>
 #include <deque>
 #include <limits>
 #include <optional>
@@ -28,6 +30,7 @@
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
+#include "tilth/replay_host_time.h"
 
 namespace tilth::mcap {
 namespace {
@@ -67,6 +70,7 @@ class McapPlayer final : public Source {
       : reader_(context.params.path("path")),
         calibration_(read_calibration(reader_)),
         clock_(context.params.number("rate")),
+        host_time_(context.params),
         log_(context.log) {
     for (const auto& [id, channel] : reader_.channels()) {
       if (channel.topic == kRawTopic) raw_channel_ = id;
@@ -108,9 +112,10 @@ class McapPlayer final : public Source {
       }
       const std::uint64_t time = recorded.raw->log_time;
       if (time < start_ns_ || time > end_ns_) continue;
-      // Paced by the depth log times, relative to the first frame played.
-      if (!clock_.wait(static_cast<std::int64_t>(time))) return false;
-      emit(frame, recorded);
+      Outputs outputs = decode(recorded);
+      // Paced by the depth device times, relative to the first frame played.
+      if (!clock_.wait(outputs.raw.device_timestamp_ns)) return false;
+      emit(frame, recorded, std::move(outputs));
       return true;
     }
   }
@@ -139,8 +144,10 @@ class McapPlayer final : public Source {
       if (chunk.message_end_time < start_ns_ || chunk.message_start_time > end_ns_) continue;
       chunks_.push_back(chunk);
     }
-    std::stable_sort(chunks_.begin(), chunks_.end(), [](const ChunkIndex& a, const ChunkIndex& b) {
-      return a.message_start_time < b.message_start_time;
+    // In the order they were written, the frames' order: host log times may step back
+    // (the host clock set by NTP) where device times and frame ids do not.
+    std::sort(chunks_.begin(), chunks_.end(), [](const ChunkIndex& a, const ChunkIndex& b) {
+      return a.chunk_start_offset < b.chunk_start_offset;
     });
   }
 
@@ -197,43 +204,53 @@ class McapPlayer final : public Source {
     return decoded;
   }
 
-  void emit(Frame& frame, const RecordedFrame& recorded) const {
+  struct Outputs {
+    RawTofFrame raw;
+    ColorImage color;
+    GroundTruth truth;
+  };
+
+  Outputs decode(const RecordedFrame& recorded) const {
     const cv::Size depth_size(calibration_.depth.width, calibration_.depth.height);
     const cv::Size color_size(calibration_.color.width, calibration_.color.height);
+    Outputs outputs;
 
-    RawTofFrame raw;
-    raw.gray = image(*recorded.raw, depth_size, "mono16").pixels;
-    raw.device_timestamp_ns = static_cast<std::int64_t>(recorded.raw->log_time);
+    RawImage raw_image = image(*recorded.raw, depth_size, "mono16");
+    outputs.raw.gray = std::move(raw_image.pixels);
+    outputs.raw.device_timestamp_ns = raw_image.timestamp_ns;
 
-    ColorImage color;
     RawImage color_image = image(*recorded.color, color_size, "");
     const std::optional<PixelFormat> format = parse_pixel_format(color_image.encoding);
     if (!format) {
       throw Error(where(*recorded.color) + ": encoding " + color_image.encoding +
                   " is not a Tilth pixel format");
     }
-    color.format = *format;
-    color.pixels = std::move(color_image.pixels);
-    color.device_timestamp_ns = static_cast<std::int64_t>(recorded.color->log_time);
+    outputs.color.format = *format;
+    outputs.color.pixels = std::move(color_image.pixels);
+    outputs.color.device_timestamp_ns = color_image.timestamp_ns;
 
-    GroundTruth truth;
     if (recorded.truth) {
-      truth.distance_mm =
+      outputs.truth.distance_mm =
           decode_ground_truth(recorded.truth->data, where(*recorded.truth)).distance_mm;
     }
-    if (recorded.mask) truth.residue_mask = image(*recorded.mask, depth_size, "mono8").pixels;
+    if (recorded.mask) {
+      outputs.truth.residue_mask = image(*recorded.mask, depth_size, "mono8").pixels;
+    }
+    return outputs;
+  }
 
-    const auto host_now = std::chrono::system_clock::now().time_since_epoch();
-    frame.set_capture(recorded.sequence, raw.device_timestamp_ns,
-                      std::chrono::duration_cast<std::chrono::nanoseconds>(host_now).count());
-    frame.emit(kRawPort, std::move(raw));
-    frame.emit(kColorPort, std::move(color));
-    frame.emit(kTruthPort, std::move(truth));
+  void emit(Frame& frame, const RecordedFrame& recorded, Outputs outputs) const {
+    frame.set_capture(recorded.sequence, outputs.raw.device_timestamp_ns,
+                      host_time_.stamp(static_cast<std::int64_t>(recorded.raw->log_time)));
+    frame.emit(kRawPort, std::move(outputs.raw));
+    frame.emit(kColorPort, std::move(outputs.color));
+    frame.emit(kTruthPort, std::move(outputs.truth));
   }
 
   McapReader reader_;
   const RigCalibration calibration_;
   PlaybackClock clock_;
+  const ReplayHostTime host_time_;
   const Logger log_;
   std::optional<std::uint16_t> raw_channel_;
   std::optional<std::uint16_t> color_channel_;
@@ -252,8 +269,9 @@ StageDescriptor describe() {
   d.type = "mcap.player";
   d.summary = "replays an MCAP recording made by mcap.writer, also one cut off mid-write";
   d.outputs = {
-      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray; device time = its log time"),
-      PortSpec::of<ColorImage>("color", "the colour image as recorded; device time = its log time"),
+      PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray; device time = the image's timestamp"),
+      PortSpec::of<ColorImage>("color",
+                               "the colour image as recorded; device time = the image's timestamp"),
       PortSpec::of<GroundTruth>("truth", "the recorded distance and mask; empty when none"),
   };
   d.params = {
@@ -261,15 +279,20 @@ StageDescriptor describe() {
       ParamSpec::number("rate", 0.0)
           .range(0, std::nullopt)
           .describe("playback speed: 0 = as fast as possible, 1 = as recorded (paced by the depth "
-                    "timestamps), 2 = twice as fast"),
+                    "images' device timestamps), 2 = twice as fast"),
       ParamSpec::number("start_s", 0.0)
           .range(0, std::nullopt)
           .in_unit("s")
-          .describe("first frame to play, from the recording's first message"),
+          .describe(
+              "first frame to play, by its log time (the recorded host capture time), from the "
+              "recording's first message"),
       ParamSpec::number("end_s", 0.0)
           .range(0, std::nullopt)
           .in_unit("s")
-          .describe("last frame to play, from the recording's first message; 0 = the end"),
+          .describe(
+              "last frame to play, by its log time (the recorded host capture time), from the "
+              "recording's first message; 0 = the end"),
+      ReplayHostTime::param("the depth message's log time"),
   };
   d.concurrency = Concurrency::kSerial;
   d.create = factory<McapPlayer>();

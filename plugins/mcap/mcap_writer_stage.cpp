@@ -7,6 +7,10 @@
 //
 // Invariant: a frame's messages are never split across chunks (a chunk is closed only
 // between frames), so a file cut off mid-write loses whole frames, never half of one.
+//
+// As in a ROS 2 bag, a message's log (and publish) time is when the frame was captured
+// on the host's clock, so Foxglove shows wall-clock dates; each image's own timestamp
+// is its device time.
 #include <chrono>
 #include <fstream>
 #include <limits>
@@ -63,6 +67,16 @@ std::uint64_t device_time(std::string_view port, std::int64_t timestamp_ns) {
   return static_cast<std::uint64_t>(timestamp_ns);
 }
 
+// The frame's host capture time, or its depth device time when the host's is unknown (0).
+std::uint64_t host_time(const FrameInfo& info, std::uint64_t depth_time) {
+  if (info.host_timestamp_ns < 0) {
+    throw Error("host timestamp " + std::to_string(info.host_timestamp_ns) +
+                " ns; expected >= 0 (MCAP times are unsigned)");
+  }
+  return info.host_timestamp_ns != 0 ? static_cast<std::uint64_t>(info.host_timestamp_ns)
+                                     : depth_time;
+}
+
 WriterOptions writer_options(const Params& params) {
   WriterOptions options;
   const std::string compression = params.string("compression");
@@ -80,13 +94,15 @@ class McapWriterStage final : public Sink {
                                        context.params.path("calibration").string())),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
         color_size_(calibration_.color.width, calibration_.color.height),
-        writer_(context.params.path("path"), writer_options(context.params)) {
+        writer_(context.params.path("path"), writer_options(context.params)),
+        log_host_time_(context.params.string("log_time") == "host") {
     const std::uint64_t created = now_ns();
     writer_.add_attachment({created, created, std::string(kCalibrationAttachment),
                             "application/json", calibration_text_});
     writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", calibration_text_}}});
     const fs::path graph = context.params.string("graph_file");
-    std::map<std::string, std::string> recording{{"node", context.node}};
+    std::map<std::string, std::string> recording{{"node", context.node},
+                                                 {"log_time", context.params.string("log_time")}};
     if (!graph.empty()) {
       writer_.add_attachment(
           {created, created, graph.filename().string(), "application/json", read_file(graph)});
@@ -127,18 +143,22 @@ class McapWriterStage final : public Sink {
     if (has_mask) check_image("truth mask", truth->residue_mask, CV_8UC1, depth_size_);
     const std::uint64_t raw_time = device_time("raw", raw.device_timestamp_ns);
     const std::uint64_t color_time = device_time("color", color.device_timestamp_ns);
+    // Log times: the frame's host capture time for every message, or each image's device time.
+    const std::uint64_t raw_log_time =
+        log_host_time_ ? host_time(frame.info(), raw_time) : raw_time;
+    const std::uint64_t color_log_time = log_host_time_ ? raw_log_time : color_time;
 
-    writer_.write(raw_channel_, sequence, raw_time, raw_time,
+    writer_.write(raw_channel_, sequence, raw_log_time, raw_log_time,
                   encode_raw_image(raw.gray, "mono16", raw.device_timestamp_ns, kTofFrameId));
-    writer_.write(color_channel_, sequence, color_time, color_time,
+    writer_.write(color_channel_, sequence, color_log_time, color_log_time,
                   encode_raw_image(color.pixels, to_string(color.format), color.device_timestamp_ns,
                                    kColorFrameId));
     if (truth != nullptr) {
-      writer_.write(truth_channel_, sequence, raw_time, raw_time,
+      writer_.write(truth_channel_, sequence, raw_log_time, raw_log_time,
                     encode_ground_truth(truth->distance_mm, has_mask, raw.device_timestamp_ns));
       if (has_mask) {
         writer_.write(
-            mask_channel_, sequence, raw_time, raw_time,
+            mask_channel_, sequence, raw_log_time, raw_log_time,
             encode_raw_image(truth->residue_mask, "mono8", raw.device_timestamp_ns, kTofFrameId));
       }
     }
@@ -153,6 +173,7 @@ class McapWriterStage final : public Sink {
   const cv::Size depth_size_;
   const cv::Size color_size_;
   McapWriter writer_;
+  const bool log_host_time_;
   std::uint16_t raw_channel_ = 0;
   std::uint16_t color_channel_ = 0;
   std::uint16_t truth_channel_ = 0;
@@ -176,6 +197,11 @@ StageDescriptor describe() {
       ParamSpec::choice("when_behind", {"store", "wait"}, "store")
           .describe("a chunk closed while two others are still being compressed: store it "
                     "uncompressed (the recording keeps up with the cameras) or wait for them"),
+      ParamSpec::choice("log_time", {"host", "device"}, "host")
+          .describe("the messages' log and publish time: the frame's host capture time (its "
+                    "depth device time when unknown), or each image's device time (for frames "
+                    "whose host time is not a capture time, such as an image folder without "
+                    "host_timestamps.csv replays)"),
       ParamSpec::integer("chunk_size", 4 * 1024 * 1024)
           .range(1, std::nullopt)
           .in_unit("bytes")

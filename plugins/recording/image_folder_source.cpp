@@ -1,14 +1,16 @@
 // Replays an image-folder recording (spec: tilth-image-folder/1): raw ToF frames, colour
 // images and ground truth, in frames.csv order, as fast as possible or paced by the
-// depth timestamps. recording.json and all of frames.csv are checked before the first
-// frame, so a malformed recording fails before the graph runs; the PNGs are read frame
-// by frame.
-#include <chrono>
+// depth timestamps, stamped when they are played or, with host_time: recorded, with the
+// host capture times of host_timestamps.csv when the folder has one. recording.json, all
+// of frames.csv and host_timestamps.csv are checked before the first frame, whichever
+// host times are used, so a malformed recording fails before the graph runs; the PNGs
+// are read frame by frame.
 #include <optional>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "frames_csv.h"
+#include "host_timestamps_csv.h"
 #include "pixel_checks.h"
 #include "recording_json.h"
 #include "tilth/messages/color_image.h"
@@ -16,6 +18,7 @@
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
+#include "tilth/replay_host_time.h"
 
 namespace tilth::recording {
 namespace {
@@ -25,6 +28,14 @@ namespace fs = std::filesystem;
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
+
+// Each frame's host capture time from host_timestamps.csv; none without the file.
+std::vector<std::int64_t> recorded_host_timestamps(const fs::path& folder,
+                                                   const std::vector<FrameEntry>& frames) {
+  const fs::path file = folder / kHostTimestampsFile;
+  if (!fs::exists(file)) return {};
+  return read_host_timestamps(file, frames);
+}
 
 struct FrameImages {
   cv::Mat depth;
@@ -38,6 +49,8 @@ class ImageFolderSource final : public Source {
       : folder_(context.params.path("path")),
         recording_(read_recording_json(folder_)),
         frames_(read_frames_csv(folder_ / "frames.csv")),
+        host_timestamps_(recorded_host_timestamps(folder_, frames_)),
+        host_time_(context.params),
         clock_(context.params.number("rate")),
         stop_on_missing_(context.params.string("on_missing") == "stop"),
         loop_(context.params.boolean("loop")),
@@ -57,11 +70,12 @@ class ImageFolderSource final : public Source {
         clock_.restart();
         produced_this_pass_ = false;
       }
-      const FrameEntry& entry = frames_[next_++];
+      const std::size_t position = next_++;
+      const FrameEntry& entry = frames_[position];
       // Paced by the depth timestamps, relative to the first frame of the pass.
       if (!clock_.wait(entry.depth_timestamp_ns)) return false;
       if (auto images = read_images(entry)) {
-        emit(frame, entry, std::move(*images));
+        emit(frame, entry, host_timestamp(position), std::move(*images));
         produced_this_pass_ = true;
         return true;
       }
@@ -117,10 +131,14 @@ class ImageFolderSource final : public Source {
     return image;
   }
 
-  void emit(Frame& frame, const FrameEntry& entry, FrameImages images) const {
-    const auto host_now = std::chrono::system_clock::now().time_since_epoch();
-    frame.set_capture(entry.index, entry.depth_timestamp_ns,
-                      std::chrono::duration_cast<std::chrono::nanoseconds>(host_now).count());
+  std::int64_t host_timestamp(std::size_t position) const {
+    if (host_timestamps_.empty()) return host_time_.stamp(std::nullopt);
+    return host_time_.stamp(host_timestamps_[position]);
+  }
+
+  void emit(Frame& frame, const FrameEntry& entry, std::int64_t host_timestamp_ns,
+            FrameImages images) const {
+    frame.set_capture(entry.index, entry.depth_timestamp_ns, host_timestamp_ns);
     RawTofFrame raw;
     raw.gray = std::move(images.depth);
     raw.device_timestamp_ns = entry.depth_timestamp_ns;
@@ -139,6 +157,8 @@ class ImageFolderSource final : public Source {
   const fs::path folder_;
   const RecordingJson recording_;
   const std::vector<FrameEntry> frames_;
+  const std::vector<std::int64_t> host_timestamps_;  // one per frame; empty: not recorded
+  const ReplayHostTime host_time_;
   PlaybackClock clock_;
   const bool stop_on_missing_;
   const bool loop_;
@@ -169,6 +189,7 @@ StageDescriptor describe() {
       ParamSpec::choice("on_missing", {"skip", "stop"}, "skip")
           .describe("a missing or unreadable PNG: skip the frame with a warning, or stop"),
       ParamSpec::boolean("loop", false).describe("start again after the last frame"),
+      ReplayHostTime::param("host_timestamps.csv's, or when played without it"),
   };
   d.concurrency = Concurrency::kSerial;
   d.create = factory<ImageFolderSource>();

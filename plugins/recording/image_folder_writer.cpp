@@ -1,8 +1,9 @@
 // Writes frames as an image-folder recording (spec: tilth-image-folder/1) that
-// recording.image_folder replays. Every frame is checked against what the reader
-// accepts before any of its files is written, and its frames.csv line is appended and
-// flushed only after its PNGs are complete: a killed process leaves a valid recording
-// that lacks at most the frame being written.
+// recording.image_folder replays, with each frame's host capture time in
+// host_timestamps.csv. Every frame is checked against what the reader accepts before any
+// of its files is written, and its lines are appended and flushed only after its PNGs
+// are complete, host_timestamps.csv's before frames.csv's: a killed process leaves a
+// valid recording that lacks at most the frame being written.
 #include <array>
 #include <fstream>
 #include <iomanip>
@@ -13,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "frames_csv.h"
+#include "host_timestamps_csv.h"
 #include "pixel_checks.h"
 #include "recording_json.h"
 #include "tilth/messages/color_image.h"
@@ -30,8 +32,9 @@ constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
 constexpr std::string_view kCalibrationFile = "rig.calib.json";
 // What replacing a recording removes; anything else in the folder stays.
-constexpr std::array<std::string_view, 6> kRecordingEntries{
-    "recording.json", "frames.csv", kCalibrationFile, "depth", "color", "mask"};
+constexpr std::array<std::string_view, 7> kRecordingEntries{
+    "recording.json", "frames.csv", kHostTimestampsFile, kCalibrationFile, "depth",
+    "color",          "mask"};
 
 // The frame's file name: its index, six digits or more.
 std::string file_name(std::uint64_t index) {
@@ -76,6 +79,27 @@ void write_png(const fs::path& file, const cv::Mat& image) {
   if (!cv::imwrite(file.string(), image)) throw Error(file.string() + ": cannot write PNG");
 }
 
+// The frame's host capture time, or its depth device time when the host's is unknown
+// (0), as mcap.writer records it.
+std::int64_t recorded_host_time(const FrameInfo& info, std::int64_t depth_timestamp_ns) {
+  if (info.host_timestamp_ns < 0) {
+    throw Error("host timestamp " + std::to_string(info.host_timestamp_ns) +
+                " ns; expected >= 0 (CLOCK_REALTIME)");
+  }
+  return info.host_timestamp_ns != 0 ? info.host_timestamp_ns : depth_timestamp_ns;
+}
+
+// Appends a line and flushes it.
+void append_line(std::ofstream& out, const std::string& line, const fs::path& file) {
+  out << line << "\n" << std::flush;
+  if (!out) throw Error(file.string() + ": cannot write");
+}
+
+void close_file(std::ofstream& out, const fs::path& file) {
+  out.close();
+  if (!out) throw Error(file.string() + ": cannot write");
+}
+
 class ImageFolderWriter final : public Sink {
  public:
   explicit ImageFolderWriter(const StageContext& context)
@@ -105,6 +129,7 @@ class ImageFolderWriter final : public Sink {
       entry.mask = "mask/" + file_name(entry.index);
     }
     if (truth != nullptr) entry.ground_truth_mm = truth->distance_mm;
+    const std::int64_t host_time = recorded_host_time(frame.info(), entry.depth_timestamp_ns);
     check_order(entry);
     check("raw",
           pixel_mismatch(raw.gray, CV_16UC1, depth_size_, "depth_camera in the calibration"));
@@ -121,16 +146,17 @@ class ImageFolderWriter final : public Sink {
       fs::create_directories(folder_ / "mask");
       write_png(folder_ / entry.mask, truth->residue_mask);
     }
-    csv_ << frames_csv_line(entry) << "\n" << std::flush;
-    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+    append_line(host_csv_, host_timestamps_line(entry.index, host_time),
+                folder_ / kHostTimestampsFile);
+    append_line(csv_, frames_csv_line(entry), folder_ / "frames.csv");
     previous_ = entry;
   }
 
   void finish() override {
     // A recording without frames is still a valid, empty one.
     if (!color_format_) start(PixelFormat::kBgr8);
-    csv_.close();
-    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+    close_file(csv_, folder_ / "frames.csv");
+    close_file(host_csv_, folder_ / kHostTimestampsFile);
   }
 
  private:
@@ -144,9 +170,10 @@ class ImageFolderWriter final : public Sink {
     std::ofstream calibration(folder_ / kCalibrationFile, std::ios::binary);
     calibration << calibration_text_;
     if (!calibration) throw Error((folder_ / kCalibrationFile).string() + ": cannot write");
+    host_csv_.open(folder_ / kHostTimestampsFile);
+    append_line(host_csv_, std::string(kHostTimestampsHeader), folder_ / kHostTimestampsFile);
     csv_.open(folder_ / "frames.csv");
-    csv_ << kFramesCsvHeader << "\n" << std::flush;
-    if (!csv_) throw Error((folder_ / "frames.csv").string() + ": cannot write");
+    append_line(csv_, std::string(kFramesCsvHeader), folder_ / "frames.csv");
     color_format_ = color_format;
   }
 
@@ -196,7 +223,8 @@ class ImageFolderWriter final : public Sink {
   const std::string description_;
   const cv::Size depth_size_;
   const cv::Size color_size_;
-  std::ofstream csv_;
+  std::ofstream csv_;                        // frames.csv
+  std::ofstream host_csv_;                   // host_timestamps.csv
   std::optional<PixelFormat> color_format_;  // set by start(), from the first written frame
   std::optional<FrameEntry> previous_;
 };
@@ -204,7 +232,9 @@ class ImageFolderWriter final : public Sink {
 StageDescriptor describe() {
   StageDescriptor d;
   d.type = "recording.image_folder_writer";
-  d.summary = "writes frames as an image-folder recording (PNG files and frames.csv)";
+  d.summary =
+      "writes frames as an image-folder recording (PNG files, frames.csv and "
+      "host_timestamps.csv)";
   d.inputs = {
       PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
       PortSpec::of<ColorImage>("color", "bgr8, rgb8 (stored as bgr8) or a Bayer mosaic"),

@@ -19,6 +19,7 @@ RunResult McapTest::record(const fs::path& file, PixelFormat format, json writer
   for (const TestFrame& frame : frames_) {
     Feed feed;
     feed.frame_id = frame.index;
+    feed.host_timestamp_ns = frame.host_timestamp_ns;
     feed.raw.gray = frame.depth;
     feed.raw.device_timestamp_ns = frame.depth_timestamp_ns;
     feed.color.pixels = frame.color;
@@ -40,8 +41,7 @@ RunResult McapTest::record(const fs::path& file, PixelFormat format, json writer
   return run(graph.dump());
 }
 
-RunResult McapTest::play(const fs::path& file, json player_params) {
-  captured_.clear();
+std::string McapTest::player_graph(const fs::path& file, json player_params) {
   player_params["path"] = file.string();
   const json graph = {
       {"nodes",
@@ -49,7 +49,12 @@ RunResult McapTest::play(const fs::path& file, json player_params) {
         {"out", {{"type", "test.capture"}}}}},
       {"edges", json::array({edge("src.raw", "out.raw"), edge("src.color", "out.color"),
                              edge("src.truth", "out.truth")})}};
-  return run(graph.dump());
+  return graph.dump();
+}
+
+RunResult McapTest::play(const fs::path& file, json player_params) {
+  captured_.clear();
+  return run(player_graph(file, std::move(player_params)));
 }
 
 void McapTest::expect_played(PixelFormat format, std::size_t first, std::size_t count) {
@@ -59,6 +64,8 @@ void McapTest::expect_played(PixelFormat format, std::size_t first, std::size_t 
     const TestFrame& expected = frames_[first + i];
     const Captured& got = captured_[i];
     EXPECT_EQ(got.info.frame_id, expected.index);
+    EXPECT_EQ(got.info.device_timestamp_ns, expected.depth_timestamp_ns);
+    EXPECT_EQ(got.info.host_timestamp_ns, expected.host_timestamp_ns);
     EXPECT_TRUE(same_pixels(expected.depth, got.raw->gray));
     EXPECT_EQ(got.raw->device_timestamp_ns, expected.depth_timestamp_ns);
     EXPECT_TRUE(same_pixels(expected.color, got.color->pixels));

@@ -16,9 +16,12 @@ class McapTest : public RecordingTest {
 
   // test.feed (frames_ in `format`, each with its truth) -> mcap.writer at `file`.
   RunResult record(const fs::path& file, PixelFormat format, nlohmann::json writer_params = {});
-  // mcap.player -> test.capture; captured_ holds what it played.
+  // mcap.player -> test.capture.
+  static std::string player_graph(const fs::path& file, nlohmann::json player_params = {});
+  // Runs player_graph(); captured_ holds what it played.
   RunResult play(const fs::path& file, nlohmann::json player_params = {});
-  // captured_ holds exactly frames_[first, first + count) as recorded.
+  // captured_ holds exactly frames_[first, first + count) as recorded, host times too
+  // (played with host_time: recorded).
   void expect_played(PixelFormat format, std::size_t first, std::size_t count);
 
   const fs::path calibration_file_ = dir_.path() / "small.calib.json";

@@ -61,7 +61,7 @@ TEST_F(McapRecoveryTest, CutFilePlaysItsCompleteChunksAndRepairs) {
     const fs::path cut_file = dir_.path() / "cut.mcap";
     copy_prefix(complete_, cut_file, cut.size);
 
-    const RunResult played = play(cut_file);
+    const RunResult played = play(cut_file, {{"host_time", "recorded"}});
     ASSERT_FALSE(played.failed) << played.failure;
     expect_played(PixelFormat::kBgr8, 0, cut.complete_chunks);
     EXPECT_TRUE(warned("no summary (the recording was cut off while written?); recovered " +
@@ -76,7 +76,7 @@ TEST_F(McapRecoveryTest, CutFilePlaysItsCompleteChunksAndRepairs) {
     EXPECT_EQ(reader.chunks().size(), cut.complete_chunks);
     EXPECT_EQ(reader.statistics()->message_count, result.messages);
     EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
-    ASSERT_FALSE(play(repaired).failed);
+    ASSERT_FALSE(play(repaired, {{"host_time", "recorded"}}).failed);
     expect_played(PixelFormat::kBgr8, 0, cut.complete_chunks);
   }
 }

@@ -1,8 +1,13 @@
-// mcap.writer -> mcap.player through the real runtime: every pixel, timestamp and truth
-// survives in each pixel format and compression; what the file holds (channels,
-// schemas, attachments, metadata, summary); seeking by time; every chunk compressed at
-// the rig's full image sizes when the writer is told to wait.
+// mcap.writer -> mcap.player through the real runtime: every pixel, timestamp (device
+// and host, with host_time: recorded) and truth survives in each pixel format and
+// compression; by default frames get host times when played; what the file holds
+// (channels, schemas, attachments, metadata, summary); log times are host capture times
+// and image stamps device times, or device times in both (log_time: device, and older
+// recordings); seeking by log time, pacing by device time, playing chunks in the order
+// written; every chunk compressed at the rig's full image sizes when the writer is told
+// to wait.
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 
@@ -16,17 +21,78 @@ namespace {
 
 using nlohmann::json;
 
-class McapStagesTest : public McapTest {};
+class McapStagesTest : public McapTest {
+ protected:
+  // Every message of the file, in the order written, with its channel's topic.
+  static std::vector<std::pair<std::string, mcap::Message>> messages_of(const fs::path& file) {
+    mcap::McapReader reader(file);
+    std::vector<std::pair<std::string, mcap::Message>> messages;
+    for (const mcap::ChunkIndex& chunk : reader.chunks()) {
+      for (mcap::Message& message : reader.read_chunk(chunk)) {
+        messages.emplace_back(reader.channels().at(message.channel_id).topic, std::move(message));
+      }
+    }
+    return messages;
+  }
+
+  // The image timestamp of a RawImage message, or the `timestamp` of a /truth message.
+  static std::int64_t stamp_of(const std::string& topic, const mcap::Message& message) {
+    if (topic == "/truth") {
+      const json stamp = json::parse(message.data)["timestamp"];
+      return stamp["sec"].get<std::int64_t>() * 1'000'000'000 + stamp["nsec"].get<std::int64_t>();
+    }
+    return mcap::decode_raw_image(message.data, topic).timestamp_ns;
+  }
+
+  // Null when no frame has the id.
+  const TestFrame* frame_with_id(std::uint64_t id) const {
+    const auto found = std::find_if(frames_.begin(), frames_.end(),
+                                    [&](const TestFrame& frame) { return frame.index == id; });
+    return found == frames_.end() ? nullptr : &*found;
+  }
+};
 
 TEST_F(McapStagesTest, RoundTripKeepsEveryPixelTimestampAndTruth) {
   frames_ = make_frames(5, small_calibration(), 3);
   const fs::path file = dir_.path() / "bgr.mcap";
   const RunResult recorded = record(file, PixelFormat::kBgr8);
   ASSERT_FALSE(recorded.failed) << recorded.failure;
-  const RunResult played = play(file);
+  const RunResult played = play(file, {{"host_time", "recorded"}});
   ASSERT_FALSE(played.failed) << played.failure;
   expect_played(PixelFormat::kBgr8, 0, frames_.size());
   EXPECT_TRUE(warnings().empty());
+}
+
+// By default, as live: the host clock when each frame is played, not its log time.
+TEST_F(McapStagesTest, HostTimesAreWhenPlayedByDefault) {
+  frames_ = make_frames(3, small_calibration(), 3);
+  const fs::path file = dir_.path() / "replayed.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
+  for (const json& params : {json::object(), json{{"host_time", "replayed"}}}) {
+    SCOPED_TRACE(params.dump());
+    const auto before = std::chrono::system_clock::now().time_since_epoch().count();
+    const RunResult played = play(file, params);
+    const auto after = std::chrono::system_clock::now().time_since_epoch().count();
+    ASSERT_FALSE(played.failed) << played.failure;
+    ASSERT_EQ(captured_.size(), frames_.size());
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      EXPECT_EQ(captured_[i].info.frame_id, frames_[i].index);
+      EXPECT_EQ(captured_[i].info.device_timestamp_ns, frames_[i].depth_timestamp_ns) << i;
+      EXPECT_GE(captured_[i].info.host_timestamp_ns, before) << i;
+      EXPECT_LE(captured_[i].info.host_timestamp_ns, after) << i;
+      EXPECT_NE(captured_[i].info.host_timestamp_ns, frames_[i].host_timestamp_ns) << i;
+    }
+  }
+}
+
+TEST_F(McapStagesTest, AnUnknownHostTimeIsRefusedBeforeTheGraphRuns) {
+  frames_ = make_frames(1, small_calibration(), 3);
+  const fs::path file = dir_.path() / "refused.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
+  EXPECT_EQ(start_error(player_graph(file, {{"host_time", "live"}})),
+            (dir_.path() / "graph.json").string() +
+                ":/nodes/src/params/host_time: parameter 'host_time': expected one of "
+                "'replayed', 'recorded', got \"live\"");
 }
 
 TEST_F(McapStagesTest, RoundTripOfBayerAtFullSizeInEveryCompression) {
@@ -39,7 +105,7 @@ TEST_F(McapStagesTest, RoundTripOfBayerAtFullSizeInEveryCompression) {
         record(file, PixelFormat::kBayerGrbg8,
                {{"compression", compression}, {"calibration", shipped_calibration_file()}});
     ASSERT_FALSE(recorded.failed) << recorded.failure;
-    const RunResult played = play(file);
+    const RunResult played = play(file, {{"host_time", "recorded"}});
     ASSERT_FALSE(played.failed) << played.failure;
     expect_played(PixelFormat::kBayerGrbg8, 0, frames_.size());
     mcap::McapReader reader(file);
@@ -78,14 +144,18 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
       {"/tof/raw", 4}, {"/color/image", 4}, {"/truth", 2}, {"/truth/mask", 2}};
   EXPECT_EQ(counts, expected_counts);
   EXPECT_EQ(reader.chunks().size(), 4u);  // chunk_size 1: one frame per chunk
-  EXPECT_EQ(reader.statistics()->message_start_time, 1'000'000'000u);
-  EXPECT_EQ(reader.statistics()->message_end_time, 1'300'400'000u);
+  // Log times are host capture times.
+  EXPECT_EQ(reader.statistics()->message_start_time, 1'763'800'000'002'000'000u);
+  EXPECT_EQ(reader.statistics()->message_end_time, 1'763'800'000'302'000'000u);
 
   EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
   EXPECT_EQ(reader.find_attachment("recorded.graph.json")->data, read_text(graph_file));
   ASSERT_EQ(reader.metadata().size(), 2u);
   EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("json"),
             read_text(calibration_file_));
+  const std::map<std::string, std::string> recording{
+      {"node", "w"}, {"graph_file", "recorded.graph.json"}, {"log_time", "host"}};
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values, recording);
 
   // The first colour message: a RawImage in CDR, byte by byte where it is not pixels.
   const std::vector<mcap::Message> messages = reader.read_chunk(reader.chunks().front());
@@ -109,8 +179,8 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   EXPECT_EQ(cdr.substr(head.size()),
             std::string(reinterpret_cast<const char*>(frames_[0].color.data), 3600));
   EXPECT_EQ(messages[1].sequence, 3u);
-  EXPECT_EQ(messages[1].log_time, 1'000'400'000u);
-  EXPECT_EQ(messages[1].publish_time, 1'000'400'000u);
+  EXPECT_EQ(messages[1].log_time, 1'763'800'000'002'000'000u);
+  EXPECT_EQ(messages[1].publish_time, 1'763'800'000'002'000'000u);
   const mcap::RawImage color = mcap::decode_raw_image(cdr, "test");
   EXPECT_EQ(color.encoding, "bgr8");
   EXPECT_EQ(color.frame_id, "color");
@@ -122,15 +192,21 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   EXPECT_TRUE(info.has_summary);
   EXPECT_EQ(info.message_count, 12u);
   EXPECT_EQ(info.chunk_count, 4u);
-  EXPECT_DOUBLE_EQ(info.duration_s(), 0.3004);
+  EXPECT_DOUBLE_EQ(info.duration_s(), 0.3);
   EXPECT_NE(
       mcap::format_info(info).find("/truth/mask  2 messages  foxglove_msgs/msg/RawImage (cdr)"),
       std::string::npos)
       << mcap::format_info(info);
 }
 
-TEST_F(McapStagesTest, SeeksByTimeWithoutReadingTheChunksBefore) {
+// The window is in log time, the host capture times, here twice as far apart as the
+// device times.
+TEST_F(McapStagesTest, SeeksByLogTimeWithoutReadingTheChunksBefore) {
   frames_ = make_frames(10, small_calibration(), 3);
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    frames_[i].host_timestamp_ns =
+        1'763'800'000'000'000'000 + static_cast<std::int64_t>(i) * 200'000'000;
+  }
   const fs::path file = dir_.path() / "seek.mcap";
   ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"chunk_size", 1}}).failed);
   // Damage the first chunk: a player that reads it fails.
@@ -141,14 +217,21 @@ TEST_F(McapStagesTest, SeeksByTimeWithoutReadingTheChunksBefore) {
     bytes.seekp(static_cast<std::streamoff>(first.chunk_start_offset + first.chunk_length - 10));
     bytes.put('\x55');
   }
-  const RunResult played = play(file, {{"start_s", 0.25}, {"end_s", 0.65}});
+  const RunResult played =
+      play(file, {{"start_s", 0.5}, {"end_s", 1.3}, {"host_time", "recorded"}});
   ASSERT_FALSE(played.failed) << played.failure;
-  expect_played(PixelFormat::kBgr8, 3, 4);  // depth times 0.3 .. 0.6 s after the first
+  expect_played(PixelFormat::kBgr8, 3, 4);  // host times 0.6 .. 1.2 s after the first
   EXPECT_TRUE(play(file).failed);
 }
 
-TEST_F(McapStagesTest, PacesAtTheRecordedRate) {
+// By the device times, the camera's rhythm: the host times of a recording made faster
+// than real time (a simulation) are 1 ms apart.
+TEST_F(McapStagesTest, PacesAtTheRecordedRateOfTheDeviceTimes) {
   frames_ = make_frames(4, small_calibration(), 3, 50'000'000);
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    frames_[i].host_timestamp_ns =
+        1'763'800'000'000'000'000 + static_cast<std::int64_t>(i) * 1'000'000;
+  }
   const fs::path file = dir_.path() / "paced.mcap";
   ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
   const auto start = std::chrono::steady_clock::now();
@@ -157,6 +240,97 @@ TEST_F(McapStagesTest, PacesAtTheRecordedRate) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_GE(seconds, 0.15);
   EXPECT_EQ(captured_.size(), 4u);
+}
+
+TEST_F(McapStagesTest, LogTimesAreHostCaptureTimesAndImageStampsDeviceTimes) {
+  frames_ = make_frames(3, small_calibration(), 3);
+  const fs::path file = dir_.path() / "times.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
+  const auto messages = messages_of(file);
+  ASSERT_EQ(messages.size(), 10u);  // 3 frames of raw and colour, 2 of truth and mask
+  for (const auto& [topic, message] : messages) {
+    SCOPED_TRACE(topic + " frame " + std::to_string(message.sequence));
+    const TestFrame* frame = frame_with_id(message.sequence);
+    ASSERT_NE(frame, nullptr);
+    EXPECT_EQ(message.log_time, static_cast<std::uint64_t>(frame->host_timestamp_ns));
+    EXPECT_EQ(message.publish_time, message.log_time);
+    EXPECT_EQ(stamp_of(topic, message),
+              topic == "/color/image" ? frame->color_timestamp_ns : frame->depth_timestamp_ns);
+  }
+}
+
+// log_time: device records as Tilth did before host times were recorded; such files,
+// old ones too, play with the depth device time as the frames' recorded host time.
+TEST_F(McapStagesTest, DeviceLogTimesPlayAsHostTimes) {
+  frames_ = make_frames(3, small_calibration(), 3);
+  const fs::path file = dir_.path() / "device.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"log_time", "device"}}).failed);
+  for (const auto& [topic, message] : messages_of(file)) {
+    EXPECT_EQ(message.log_time, static_cast<std::uint64_t>(stamp_of(topic, message))) << topic;
+  }
+  mcap::McapReader reader(file);
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values.at("log_time"), "device");
+
+  ASSERT_FALSE(play(file, {{"host_time", "recorded"}}).failed);
+  for (TestFrame& frame : frames_) frame.host_timestamp_ns = frame.depth_timestamp_ns;
+  expect_played(PixelFormat::kBgr8, 0, frames_.size());
+}
+
+// Through the runtime every frame has a host time (it stamps those without); a frame
+// handed to the stage without one is logged at its depth device time, not at 0.
+TEST_F(McapStagesTest, AFrameWithoutHostTimeIsLoggedAtItsDeviceTime) {
+  frames_ = make_frames(2, small_calibration(), 3);
+  const fs::path file = dir_.path() / "unknown-host.mcap";
+  StageContext context{"w",
+                       Params(json{{"path", file.string()},
+                                   {"compression", "zstd"},
+                                   {"when_behind", "wait"},
+                                   {"log_time", "host"},
+                                   {"chunk_size", 1},
+                                   {"calibration", calibration_file_.string()},
+                                   {"graph_file", ""}}),
+                       Logger("w"),
+                       {}};
+  StageInstance writer = registry_.create("mcap.writer", context);
+  auto& sink = dynamic_cast<Sink&>(*writer.stage);
+  const auto consume = [&](const TestFrame& frame, std::int64_t host_timestamp_ns) {
+    const FrameInfo info{0, frame.index, frame.depth_timestamp_ns, host_timestamp_ns};
+    RawTofFrame raw;
+    raw.gray = frame.depth;
+    raw.device_timestamp_ns = frame.depth_timestamp_ns;
+    ColorImage color;
+    color.pixels = frame.color;
+    color.device_timestamp_ns = frame.color_timestamp_ns;
+    const std::vector<Packet> inputs{Packet(info, std::make_shared<RawTofFrame>(raw)),
+                                     Packet(info, std::make_shared<ColorImage>(color)), Packet()};
+    sink.consume(Frame(info, inputs, {}));
+  };
+  consume(frames_[0], 0);
+  try {
+    consume(frames_[1], -5);
+    ADD_FAILURE() << "a negative host time was recorded";
+  } catch (const Error& error) {
+    EXPECT_STREQ(error.what(), "host timestamp -5 ns; expected >= 0 (MCAP times are unsigned)");
+  }
+  sink.finish();
+  const auto messages = messages_of(file);
+  ASSERT_EQ(messages.size(), 2u);
+  for (const auto& [topic, message] : messages) {
+    EXPECT_EQ(message.log_time, 1'000'000'000u) << topic;
+  }
+}
+
+// NTP may step the host clock back during a recording: frames still play in the order
+// they were recorded, not sorted by log time.
+TEST_F(McapStagesTest, PlaysChunksInTheOrderWrittenWhenTheHostClockStepsBack) {
+  frames_ = make_frames(4, small_calibration(), 3);
+  frames_[2].host_timestamp_ns = frames_[0].host_timestamp_ns - 5'000'000'000;
+  frames_[3].host_timestamp_ns = frames_[2].host_timestamp_ns + 100'000'000;
+  const fs::path file = dir_.path() / "stepped.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"chunk_size", 1}}).failed);
+  const RunResult played = play(file, {{"host_time", "recorded"}});
+  ASSERT_FALSE(played.failed) << played.failure;
+  expect_played(PixelFormat::kBgr8, 0, frames_.size());
 }
 
 // 640x480 mono16 + 1280x1024 bgr8 with sensor noise, as the rig delivers them: with

@@ -1,16 +1,19 @@
 """An independent reader of an image-folder recording written by `tilth run`.
 
 The test writes a recording with its own code, copies it with the graph
-recording.image_folder -> recording.image_folder_writer, and checks the copy against
-spec/recording-folder.md and the input: recording.json, the frames.csv columns, each
-PNG's bit depth and colour type (read from its header), and every pixel, decoded once by
-the small PNG decoder below (no OpenCV involved) and once by OpenCV."""
+recording.image_folder (host_time: recorded) -> recording.image_folder_writer, and
+checks the copy against spec/recording-folder.md and the input: recording.json, the
+frames.csv columns, each PNG's bit depth and colour type (read from its header), and
+every pixel, decoded once by the small PNG decoder below (no OpenCV involved) and once
+by OpenCV; and Tilth's extension host_timestamps.csv: the input's host times, or without
+them the times the copy was made."""
 import csv
 import json
 import os
 import struct
 import subprocess
 import tempfile
+import time
 import unittest
 import zlib
 
@@ -22,6 +25,7 @@ SOURCE = os.environ["TILTH_SOURCE_DIR"]
 
 HEADER = ["index", "depth_timestamp_ns", "color_timestamp_ns", "depth", "color", "mask",
           "ground_truth_mm"]
+HOST_HEADER = ["index", "host_timestamp_ns"]
 PNG_GRAY, PNG_RGB = 0, 2
 
 
@@ -94,6 +98,8 @@ def make_frames(count, color_channels, calibration):
             "index": 10 + 2 * i,
             "depth_ns": 5_000_000_000 + i * 33_333_333,
             "color_ns": 5_000_000_000 + i * 33_333_333 + 1_250_000,
+            # CLOCK_REALTIME in November 2025, with jitter.
+            "host_ns": 1_763_800_000_000_000_000 + i * 33_400_000 + (i % 2) * 250_000,
             "depth": depth,
             "color": random.integers(0, 256, color_shape, dtype=np.uint8),
             "mask": None,
@@ -106,7 +112,7 @@ def make_frames(count, color_channels, calibration):
     return frames
 
 
-def write_input_recording(folder, frames, color_format, calibration):
+def write_input_recording(folder, frames, color_format, calibration, host_timestamps=False):
     for sub in ("depth", "color", "mask", "calib"):
         os.makedirs(os.path.join(folder, sub), exist_ok=True)
     with open(os.path.join(folder, "calib", "rig.json"), "w") as f:
@@ -125,6 +131,10 @@ def write_input_recording(folder, frames, color_format, calibration):
             frame["index"], frame["depth_ns"], frame["color_ns"], name, name, mask, truth))
     with open(os.path.join(folder, "frames.csv"), "w") as f:
         f.write("\n".join(lines) + "\n")
+    if host_timestamps:
+        with open(os.path.join(folder, "host_timestamps.csv"), "w") as f:
+            f.write(",".join(HOST_HEADER) + "\n")
+            f.writelines("%d,%d\n" % (frame["index"], frame["host_ns"]) for frame in frames)
     with open(os.path.join(folder, "recording.json"), "w") as f:
         json.dump({"format": "tilth-image-folder/1", "calibration": "calib/rig.json",
                    "color_format": color_format, "description": "made by check_folder.py"}, f)
@@ -133,7 +143,8 @@ def write_input_recording(folder, frames, color_format, calibration):
 def copy_with_tilth(source, target, calibration_file, tmp):
     graph = {
         "nodes": {
-            "replay": {"type": "recording.image_folder", "params": {"path": source}},
+            "replay": {"type": "recording.image_folder",
+                       "params": {"path": source, "host_time": "recorded"}},
             "write": {"type": "recording.image_folder_writer",
                       "params": {"path": target, "calibration": calibration_file,
                                  "description": "written by tilth run"}},
@@ -149,15 +160,30 @@ def copy_with_tilth(source, target, calibration_file, tmp):
 
 
 class WrittenFolder(unittest.TestCase):
-    def check_copy(self, color_format, color_channels):
+    def check_copy(self, color_format, color_channels, host_timestamps):
         calibration = small_calibration()
         frames = make_frames(5, color_channels, calibration)
         with tempfile.TemporaryDirectory() as tmp:
             source, target = os.path.join(tmp, "in"), os.path.join(tmp, "out")
-            write_input_recording(source, frames, color_format, calibration)
+            write_input_recording(source, frames, color_format, calibration, host_timestamps)
+            start_ns = time.time_ns()
             result = copy_with_tilth(source, target, os.path.join(source, "calib", "rig.json"),
                                      tmp)
+            end_ns = time.time_ns()
             self.assertEqual(result.returncode, 0, result.stderr)
+
+            with open(os.path.join(target, "host_timestamps.csv"), newline="") as f:
+                host_rows = list(csv.reader(f))
+            self.assertEqual(host_rows[0], HOST_HEADER)
+            self.assertEqual([int(row[0]) for row in host_rows[1:]],
+                             [frame["index"] for frame in frames])
+            host_ns = [int(row[1]) for row in host_rows[1:]]
+            if host_timestamps:
+                self.assertEqual(host_ns, [frame["host_ns"] for frame in frames])
+            else:  # stamped as they were replayed
+                self.assertEqual(host_ns, sorted(host_ns))
+                self.assertGreaterEqual(host_ns[0], start_ns)
+                self.assertLessEqual(host_ns[-1], end_ns)
 
             with open(os.path.join(target, "recording.json")) as f:
                 recording = json.load(f)
@@ -216,11 +242,11 @@ class WrittenFolder(unittest.TestCase):
             self.assertEqual(float(row["ground_truth_mm"]), frame["truth"])
             self.assertGreaterEqual(len(row["ground_truth_mm"].split(".")[1]), 2)
 
-    def test_bgr8(self):
-        self.check_copy("bgr8", 3)
+    def test_bgr8_with_host_timestamps(self):
+        self.check_copy("bgr8", 3, host_timestamps=True)
 
-    def test_bayer(self):
-        self.check_copy("bayer_bggr8", 1)
+    def test_bayer_without_host_timestamps(self):
+        self.check_copy("bayer_bggr8", 1, host_timestamps=False)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // recording.image_folder through the real runtime: what it emits for a recording the
-// test writes itself, the exact error for each kind of bad input, skipping or stopping
-// on a missing PNG, pacing, interrupting a paced wait, and looping.
+// test writes itself, host capture times when played or from host_timestamps.csv, the
+// exact error for each kind of bad input, skipping or stopping on a missing PNG, pacing,
+// interrupting a paced wait, and looping.
 #include <chrono>
 #include <functional>
 #include <sstream>
@@ -66,6 +67,7 @@ class ImageFolderSourceTest : public RecordingTest {
   }
 
   std::string csv() const { return (folder_ / "frames.csv").string(); }
+  std::string host_csv() const { return (folder_ / "host_timestamps.csv").string(); }
   std::string json_file() const { return (folder_ / "recording.json").string(); }
 
   fs::path folder_ = dir_.path() / "rec";
@@ -253,6 +255,122 @@ TEST_F(ImageFolderSourceTest, IndicesAndTimestampsMustIncrease) {
 
   replace_line(4, "4,1200000000,1200400000,depth/000006.png,color/000006.png,,");
   EXPECT_EQ(start_failure(), csv() + ":4: column 'index': expected a value > 4 (line 3), got '4'");
+}
+
+// By default, as live: the host clock when each frame is played, whatever the folder
+// recorded.
+TEST_F(ImageFolderSourceTest, HostTimesAreWhenPlayedByDefault) {
+  record(4);
+  write_host_timestamps(folder_, frames_);
+  for (const json& params : {json::object(), json{{"host_time", "replayed"}}}) {
+    SCOPED_TRACE(params.dump());
+    captured_.clear();
+    const auto before = std::chrono::system_clock::now().time_since_epoch().count();
+    const RunResult result = run(replay_graph(folder_, params));
+    const auto after = std::chrono::system_clock::now().time_since_epoch().count();
+    ASSERT_FALSE(result.failed) << result.failure;
+    ASSERT_EQ(captured_.size(), frames_.size());
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      EXPECT_GE(captured_[i].info.host_timestamp_ns, before) << i;
+      EXPECT_LE(captured_[i].info.host_timestamp_ns, after) << i;
+      EXPECT_NE(captured_[i].info.host_timestamp_ns, frames_[i].host_timestamp_ns) << i;
+    }
+  }
+}
+
+TEST_F(ImageFolderSourceTest, RecordedHostTimesComeFromHostTimestampsCsv) {
+  record(4);
+  // As written on Windows, with an empty line.
+  std::string csv = "index,host_timestamp_ns\r\n\r\n";
+  for (const TestFrame& frame : frames_) {
+    csv += std::to_string(frame.index) + "," + std::to_string(frame.host_timestamp_ns) + "\r\n";
+  }
+  write_text(folder_ / "host_timestamps.csv", csv);
+  const RunResult result = run(replay_graph(folder_, {{"host_time", "recorded"}}));
+  ASSERT_FALSE(result.failed) << result.failure;
+  ASSERT_EQ(captured_.size(), frames_.size());
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    EXPECT_EQ(captured_[i].info.host_timestamp_ns, frames_[i].host_timestamp_ns) << i;
+    EXPECT_EQ(captured_[i].info.device_timestamp_ns, frames_[i].depth_timestamp_ns) << i;
+  }
+  EXPECT_EQ(frames_[3].host_timestamp_ns, 1'763'800'000'302'000'000);
+}
+
+// A folder without host_timestamps.csv recorded no host times: frames are stamped as
+// they are played.
+TEST_F(ImageFolderSourceTest, RecordedHostTimesWithoutHostTimestampsCsvAreWhenPlayed) {
+  record(3);
+  const auto before = std::chrono::system_clock::now().time_since_epoch().count();
+  const RunResult result = run(replay_graph(folder_, {{"host_time", "recorded"}}));
+  const auto after = std::chrono::system_clock::now().time_since_epoch().count();
+  ASSERT_FALSE(result.failed) << result.failure;
+  ASSERT_EQ(captured_.size(), frames_.size());
+  for (const Captured& got : captured_) {
+    EXPECT_GE(got.info.host_timestamp_ns, before) << got.info.frame_id;
+    EXPECT_LE(got.info.host_timestamp_ns, after) << got.info.frame_id;
+  }
+}
+
+TEST_F(ImageFolderSourceTest, AnUnknownHostTimeIsRefusedBeforeTheGraphRuns) {
+  record(1);
+  EXPECT_EQ(start_error(replay_graph(folder_, {{"host_time", "live"}})),
+            (dir_.path() / "graph.json").string() +
+                ":/nodes/src/params/host_time: parameter 'host_time': expected one of "
+                "'replayed', 'recorded', got \"live\"");
+}
+
+// A writer killed between a frame's two lines leaves one line more in
+// host_timestamps.csv than in frames.csv: it is ignored.
+TEST_F(ImageFolderSourceTest, AHostTimeAfterTheLastFrameIsIgnored) {
+  record(3);  // indices 3, 4, 6
+  write_host_timestamps(folder_, frames_);
+  write_text(folder_ / "host_timestamps.csv",
+             read_text(folder_ / "host_timestamps.csv") + "7,1763800000302000000\n");
+  const RunResult result = run(replay_graph(folder_, {{"host_time", "recorded"}}));
+  ASSERT_FALSE(result.failed) << result.failure;
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4, 6}));
+  EXPECT_EQ(captured_.back().info.host_timestamp_ns, frames_.back().host_timestamp_ns);
+}
+
+TEST_F(ImageFolderSourceTest, HostTimestampsCsvErrorsNameTheLineAndWhatWasExpected) {
+  record(3);  // indices 3, 4, 6 on frames.csv lines 2, 3, 4
+  const auto with_host_csv = [&](const std::string& text) {
+    write_text(folder_ / "host_timestamps.csv", text);
+    return start_failure();
+  };
+  const std::string header = "index,host_timestamp_ns\n";
+  EXPECT_EQ(with_host_csv(""),
+            host_csv() + ":1: expected the header 'index,host_timestamp_ns', got an empty file");
+  EXPECT_EQ(with_host_csv("index,host_ns\n3,1\n4,2\n6,3\n"),
+            host_csv() + ":1: expected the header 'index,host_timestamp_ns', got 'index,host_ns'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,2,7\n6,3\n"),
+            host_csv() + ":3: expected 2 fields (index,host_timestamp_ns), got '4,2,7'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4\n6,3\n"),
+            host_csv() + ":3: expected 2 fields (index,host_timestamp_ns), got '4'");
+  EXPECT_EQ(with_host_csv(header + "3,1\nfour,2\n6,3\n"),
+            host_csv() + ":3: column 'index': expected a non-negative integer, got 'four'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,17638OO000\n6,3\n"),
+            host_csv() +
+                ":3: column 'host_timestamp_ns': expected a non-negative integer number of "
+                "nanoseconds, got '17638OO000'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,-2\n6,3\n"),
+            host_csv() +
+                ":3: column 'host_timestamp_ns': expected a non-negative integer number of "
+                "nanoseconds, got '-2'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n\n6,3\n4,2\n"),
+            host_csv() + ":4: column 'index': expected 4, the index on frames.csv line 3, got '6'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,2\n"),
+            host_csv() +
+                ": ends after 2 frames; expected a line for each of the 3 frames of frames.csv, "
+                "the next for index 6 (frames.csv line 4)");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,2\n6,3\n5,4\n"),
+            host_csv() +
+                ":5: column 'index': expected a value > 6 (the last frame, frames.csv line 4), "
+                "got '5'");
+  EXPECT_EQ(with_host_csv(header + "3,1\n4,2\n6,3\n7,4\n8,5\n"),
+            host_csv() +
+                ":6: expected at most one line after the last frame of frames.csv (one a killed "
+                "writer wrote), got a second");
 }
 
 // Wrong images stop the stream: the run fails after the frames before it.

@@ -1,6 +1,6 @@
 // recording.image_folder_writer: round trips source -> writer -> source keep every pixel,
-// timestamp and truth; the files it writes; the frames it refuses; a folder it will not
-// overwrite; and that each frame is on disk before the next one arrives.
+// timestamp (device and host) and truth; the files it writes; the frames it refuses; a
+// folder it will not overwrite; and that each frame is on disk before the next one arrives.
 #include <algorithm>
 #include <functional>
 
@@ -21,14 +21,14 @@ json writer_node(const fs::path& folder, json params) {
   return {{"type", "recording.image_folder_writer"}, {"params", params}};
 }
 
-// recording.image_folder -> writer.
+// recording.image_folder -> writer, keeping the recorded host times.
 std::string copy_graph(const fs::path& from, const fs::path& to, const json& writer_params) {
-  const json graph = {
-      {"nodes",
-       {{"src", {{"type", "recording.image_folder"}, {"params", {{"path", from.string()}}}}},
-        {"w", writer_node(to, writer_params)}}},
-      {"edges", json::array({edge("src.raw", "w.raw"), edge("src.color", "w.color"),
-                             edge("src.truth", "w.truth")})}};
+  const json source_params = {{"path", from.string()}, {"host_time", "recorded"}};
+  const json graph = {{"nodes",
+                       {{"src", {{"type", "recording.image_folder"}, {"params", source_params}}},
+                        {"w", writer_node(to, writer_params)}}},
+                      {"edges", json::array({edge("src.raw", "w.raw"), edge("src.color", "w.color"),
+                                             edge("src.truth", "w.truth")})}};
   return graph.dump();
 }
 
@@ -44,11 +44,12 @@ std::string feed_graph(const fs::path& to, const json& writer_params, bool with_
   return graph.dump();
 }
 
-// recording.image_folder -> capture.
+// recording.image_folder -> capture, with the recorded host times.
 std::string replay_graph(const fs::path& folder) {
+  const json params = {{"path", folder.string()}, {"host_time", "recorded"}};
   const json graph = {
       {"nodes",
-       {{"src", {{"type", "recording.image_folder"}, {"params", {{"path", folder.string()}}}}},
+       {{"src", {{"type", "recording.image_folder"}, {"params", params}}},
         {"out", {{"type", "test.capture"}}}}},
       {"edges", json::array({edge("src.raw", "out.raw"), edge("src.color", "out.color"),
                              edge("src.truth", "out.truth")})}};
@@ -58,6 +59,7 @@ std::string replay_graph(const fs::path& folder) {
 Feed feed_of(const TestFrame& frame, PixelFormat format) {
   Feed feed;
   feed.frame_id = frame.index;
+  feed.host_timestamp_ns = frame.host_timestamp_ns;
   feed.raw.gray = frame.depth;
   feed.raw.device_timestamp_ns = frame.depth_timestamp_ns;
   feed.color.pixels = frame.color;
@@ -72,6 +74,7 @@ Feed feed_of(const TestFrame& frame, PixelFormat format) {
 
 const std::string kHeader =
     "index,depth_timestamp_ns,color_timestamp_ns,depth,color,mask,ground_truth_mm\n";
+const std::string kHostHeader = "index,host_timestamp_ns\n";
 
 class ImageFolderWriterTest : public RecordingTest {
  protected:
@@ -88,6 +91,7 @@ class ImageFolderWriterTest : public RecordingTest {
       const TestFrame& expected = frames_[i];
       const Captured& got = captured_[i];
       EXPECT_EQ(got.info.frame_id, expected.index);
+      EXPECT_EQ(got.info.host_timestamp_ns, expected.host_timestamp_ns);
       EXPECT_TRUE(same_pixels(expected.depth, got.raw->gray));
       EXPECT_EQ(got.raw->device_timestamp_ns, expected.depth_timestamp_ns);
       EXPECT_TRUE(same_pixels(expected.color, got.color->pixels));
@@ -116,6 +120,7 @@ class ImageFolderWriterTest : public RecordingTest {
 TEST_F(ImageFolderWriterTest, RoundTripKeepsEveryPixelTimestampAndTruth) {
   frames_ = make_frames(5, small_calibration(), 3);
   write_recording(original_, frames_, "bgr8", small_calibration());
+  write_host_timestamps(original_, frames_);
   const RunResult result = run(copy_graph(
       original_, copy_, {{"calibration", calibration_file_.string()}, {"description", "a copy"}}));
   ASSERT_FALSE(result.failed) << result.failure;
@@ -128,6 +133,12 @@ TEST_F(ImageFolderWriterTest, RoundTripKeepsEveryPixelTimestampAndTruth) {
           "6,1200000000,1200400000,depth/000006.png,color/000006.png,mask/000006.png,500.50\n"
           "7,1300000000,1300400000,depth/000007.png,color/000007.png,,\n"
           "8,1400000000,1400400000,depth/000008.png,color/000008.png,mask/000008.png,501.00\n");
+  EXPECT_EQ(read_text(copy_ / "host_timestamps.csv"), kHostHeader +
+                                                          "3,1763800000002000000\n"
+                                                          "4,1763800000102000000\n"
+                                                          "6,1763800000202000000\n"
+                                                          "7,1763800000302000000\n"
+                                                          "8,1763800000402000000\n");
   const json expected_recording = {{"format", "tilth-image-folder/1"},
                                    {"calibration", "rig.calib.json"},
                                    {"color_format", "bgr8"},
@@ -142,6 +153,7 @@ TEST_F(ImageFolderWriterTest, RoundTripOfABayerRecordingAtFullSize) {
   const json calibration = json::parse(read_text(shipped_calibration_file()));
   frames_ = make_frames(2, calibration, 1);
   write_recording(original_, frames_, "bayer_rggb8", calibration);
+  write_host_timestamps(original_, frames_);
   const RunResult result =
       run(copy_graph(original_, copy_, {{"calibration", shipped_calibration_file().string()}}));
   ASSERT_FALSE(result.failed) << result.failure;
@@ -243,6 +255,9 @@ TEST_F(ImageFolderWriterTest, RefusesWhatTheReaderWouldRefuse) {
   EXPECT_EQ(failure_for([](auto& feed) { feed[1].color.device_timestamp_ns = 1000400000; }),
             writer_failure("4 (sequence 1): color device timestamp: expected a value > "
                            "1000400000 (the previous frame's), got 1000400000"));
+  EXPECT_EQ(failure_for([](auto& feed) { feed[1].host_timestamp_ns = -5; }),
+            writer_failure("4 (sequence 1): host timestamp -5 ns; expected >= 0 "
+                           "(CLOCK_REALTIME)"));
   EXPECT_EQ(failure_for([](auto& feed) { feed[0].raw.gray = cv::Mat(12, 16, CV_16UC1); }),
             writer_failure("3 (sequence 0): raw: expected 16-bit 1-channel, 32x24 pixels "
                            "(depth_camera in the calibration), got 16-bit 1-channel, 16x12 "
@@ -296,6 +311,7 @@ TEST_F(ImageFolderWriterTest, ANonEmptyFolderIsReplacedOnlyWhenAskedAndOnlyAReco
   // file that is not part of a recording.
   frames_ = make_frames(5, small_calibration(), 3);
   write_recording(copy_, frames_, "bgr8", small_calibration());
+  write_host_timestamps(copy_, frames_);
   frames_.resize(1);
   feed_ = {feed_of(frames_[0], PixelFormat::kBgr8)};
   ASSERT_FALSE(
@@ -315,6 +331,7 @@ TEST_F(ImageFolderWriterTest, ANonEmptyFolderIsReplacedOnlyWhenAskedAndOnlyAReco
 TEST_F(ImageFolderWriterTest, AGraphThatDoesNotStartLeavesTheFolderAsItWas) {
   frames_ = make_frames(3, small_calibration(), 3);
   write_recording(copy_, frames_, "bgr8", small_calibration());
+  write_host_timestamps(copy_, frames_);
   const std::string csv_before = read_text(copy_ / "frames.csv");
   const std::string error =
       start_error(copy_graph(dir_.path() / "nowhere", copy_,
@@ -349,10 +366,12 @@ TEST_F(ImageFolderWriterTest, ABadCalibrationIsNamedBeforeAnythingIsWritten) {
   EXPECT_FALSE(fs::exists(copy_));
 }
 
-// A killed writer leaves a readable recording: each frame's files and its frames.csv line
-// are on disk when consume() returns.
+// A killed writer leaves a readable recording: each frame's files and its lines in
+// frames.csv and host_timestamps.csv are on disk when consume() returns. Frames that
+// reach the writer without a host time (0) are recorded with their depth device time.
 TEST_F(ImageFolderWriterTest, EachFrameIsOnDiskWhenConsumeReturns) {
   frames_ = make_frames(3, small_calibration(), 3);
+  for (TestFrame& frame : frames_) frame.host_timestamp_ns = frame.depth_timestamp_ns;
   StageContext context{"w",
                        Params(json{{"path", copy_.string()},
                                    {"calibration", calibration_file_.string()},
@@ -370,8 +389,10 @@ TEST_F(ImageFolderWriterTest, EachFrameIsOnDiskWhenConsumeReturns) {
                                      Packet(info, std::make_shared<ColorImage>(feed.color)),
                                      Packet(info, std::make_shared<GroundTruth>(*feed.truth))};
     sink.consume(Frame(info, inputs, {}));
-    const auto lines = read_text(copy_ / "frames.csv");
-    EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), static_cast<long>(i + 2));
+    for (const std::string file : {"frames.csv", "host_timestamps.csv"}) {
+      const auto lines = read_text(copy_ / file);
+      EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), static_cast<long>(i + 2)) << file;
+    }
     EXPECT_TRUE(fs::exists(copy_ / "recording.json"));
     const fs::path depth = copy_ / frame_file("depth", feed.frame_id);
     EXPECT_TRUE(same_pixels(frames_[i].depth, cv::imread(depth.string(), cv::IMREAD_UNCHANGED)));
@@ -384,6 +405,7 @@ TEST_F(ImageFolderWriterTest, EachFrameIsOnDiskWhenConsumeReturns) {
 TEST_F(ImageFolderWriterTest, NoFramesMakeAnEmptyValidRecording) {
   ASSERT_FALSE(run(feed_graph(copy_, {{"calibration", calibration_file_.string()}})).failed);
   EXPECT_EQ(read_text(copy_ / "frames.csv"), kHeader);
+  EXPECT_EQ(read_text(copy_ / "host_timestamps.csv"), kHostHeader);
   expect_recording_holds_frames(copy_, PixelFormat::kBgr8);
   EXPECT_TRUE(captured_.empty());
 }

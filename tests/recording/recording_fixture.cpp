@@ -18,7 +18,7 @@ class FeedSource final : public Source {
   bool produce(Frame& frame) override {
     if (next_ == feed_.size()) return false;
     const Feed& feed = feed_[next_++];
-    frame.set_capture(feed.frame_id, feed.raw.device_timestamp_ns, 0);
+    frame.set_capture(feed.frame_id, feed.raw.device_timestamp_ns, feed.host_timestamp_ns);
     frame.emit(0, feed.raw);
     frame.emit(1, feed.color);
     if (feed.truth) frame.emit(2, *feed.truth);
@@ -80,6 +80,7 @@ std::vector<TestFrame> make_frames(int count, const nlohmann::json& calibration,
     frame.index = 3 + static_cast<std::uint64_t>(i) + (i >= 2 ? 1 : 0);
     frame.depth_timestamp_ns = 1'000'000'000 + i * spacing_ns;
     frame.color_timestamp_ns = frame.depth_timestamp_ns + 400'000;
+    frame.host_timestamp_ns = 1'763'800'000'002'000'000 + i * spacing_ns;
     frame.depth.create(depth_size, CV_16UC1);
     random.fill(frame.depth, cv::RNG::UNIFORM, 0, 65536);
     frame.depth.at<std::uint16_t>(0, 0) = 0;
@@ -126,6 +127,13 @@ void write_recording(const fs::path& folder, const std::vector<TestFrame>& frame
                                     {"color_format", color_format},
                                     {"description", "test recording"}};
   write_text(folder / "recording.json", recording.dump(2));
+}
+
+void write_host_timestamps(const fs::path& folder, const std::vector<TestFrame>& frames) {
+  std::ostringstream csv;
+  csv << "index,host_timestamp_ns\n";
+  for (const auto& frame : frames) csv << frame.index << "," << frame.host_timestamp_ns << "\n";
+  write_text(folder / "host_timestamps.csv", csv.str());
 }
 
 std::string read_text(const fs::path& file) {

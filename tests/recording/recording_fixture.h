@@ -31,9 +31,10 @@ struct TestFrame {
   std::uint64_t index = 0;
   std::int64_t depth_timestamp_ns = 0;
   std::int64_t color_timestamp_ns = 0;
-  cv::Mat depth;  // CV_16UC1
-  cv::Mat color;  // CV_8UC3 (bgr8) or CV_8UC1 (Bayer)
-  cv::Mat mask;   // CV_8UC1 of 0, 128, 255; empty: none
+  std::int64_t host_timestamp_ns = 0;  // CLOCK_REALTIME
+  cv::Mat depth;                       // CV_16UC1
+  cv::Mat color;                       // CV_8UC3 (bgr8) or CV_8UC1 (Bayer)
+  cv::Mat mask;                        // CV_8UC1 of 0, 128, 255; empty: none
   std::optional<double> ground_truth_mm;
 };
 
@@ -43,8 +44,9 @@ fs::path shipped_calibration_file();
 nlohmann::json small_calibration();
 
 // `count` frames of random pixels in the calibration's sizes: indices from 3 with a gap,
-// depth frames 100 ms apart, colour 0.4 ms after depth; every second frame has a mask
-// and a ground truth. Depth includes 0 and 65535.
+// depth frames 100 ms apart, colour 0.4 ms after depth, host capture times as far apart
+// on a wall clock in November 2025; every second frame has a mask and a ground truth.
+// Depth includes 0 and 65535.
 std::vector<TestFrame> make_frames(int count, const nlohmann::json& calibration, int color_channels,
                                    std::int64_t spacing_ns = 100'000'000);
 
@@ -52,6 +54,8 @@ std::vector<TestFrame> make_frames(int count, const nlohmann::json& calibration,
 // recording.json with `calibration` as given (an object, or a file name in the folder).
 void write_recording(const fs::path& folder, const std::vector<TestFrame>& frames,
                      const std::string& color_format, const nlohmann::json& calibration);
+// Adds the frames' host capture times as host_timestamps.csv, the Tilth extension.
+void write_host_timestamps(const fs::path& folder, const std::vector<TestFrame>& frames);
 
 // "depth/000003.png": the file name the spec's example and the writer use.
 std::string frame_file(const std::string& folder, std::uint64_t index);
@@ -71,6 +75,7 @@ struct Captured {
 // What the feed source emits for one frame; no truth leaves that output unset.
 struct Feed {
   std::uint64_t frame_id = 0;
+  std::int64_t host_timestamp_ns = 0;  // 0: the runtime stamps the frame as it enters
   RawTofFrame raw;
   ColorImage color;
   std::optional<GroundTruth> truth;

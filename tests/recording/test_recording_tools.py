@@ -46,6 +46,12 @@ def frames_csv(folder):
         return list(csv.DictReader(f))
 
 
+def host_timestamps(folder):
+    """host_timestamps.csv as (index, host_timestamp_ns) pairs."""
+    with open(os.path.join(folder, "host_timestamps.csv"), newline="") as f:
+        return [(int(row["index"]), int(row["host_timestamp_ns"])) for row in csv.DictReader(f)]
+
+
 def read_bytes(path):
     with open(path, "rb") as f:
         return f.read()
@@ -58,8 +64,10 @@ class Simulate(unittest.TestCase):
         cls.dir = cls.tmp.name
         cls.rig = quarter_rig(cls.dir)
         cls.folder = os.path.join(cls.dir, "seed5")
+        cls.start_ns = time.time_ns()
         cls.result = tilth("simulate", cls.folder, "--preset", "case_b", "--frames", 3, "--seed", 5,
                            "--calibration", cls.rig)
+        cls.end_ns = time.time_ns()
 
     @classmethod
     def tearDownClass(cls):
@@ -86,6 +94,13 @@ class Simulate(unittest.TestCase):
             self.assertEqual((bits, kind, mask.shape), (8, PNG_GRAY, (120, 160)))
             self.assertTrue(set(np.unique(mask)) <= {0, 128, 255})
             self.assertIn(255, mask)  # case_b has straw
+        # Host capture times: when each frame was rendered.
+        host = host_timestamps(self.folder)
+        self.assertEqual([index for index, _ in host], [0, 1, 2])
+        host_ns = [ns for _, ns in host]
+        self.assertEqual(host_ns, sorted(set(host_ns)))
+        self.assertGreaterEqual(host_ns[0], self.start_ns)
+        self.assertLessEqual(host_ns[-1], self.end_ns)
         with open(os.path.join(self.folder, "recording.json")) as f:
             recording = json.load(f)
         self.assertEqual(recording["color_format"], "bgr8")
@@ -217,6 +232,25 @@ class Recording(unittest.TestCase):
             self.assertEqual(json.load(f)["color_format"], "bayer_gbrg8")
         with open(self.path("out/rig.calib.json")) as f:
             self.assertEqual(json.load(f), calibration)
+        # Without host times the MCAP file's log times are the device times, and so are the
+        # host times exported from it.
+        self.assertEqual(host_timestamps(self.path("out")),
+                         [(frame["index"], frame["depth_ns"]) for frame in frames])
+
+    def test_host_timestamps_survive_import_and_export(self):
+        calibration = small_calibration()
+        frames = make_frames(4, 3, calibration)
+        frames[2]["host_ns"] = frames[0]["host_ns"] - 2_000_000_000  # the clock set back
+        source = self.path("in")
+        write_input_recording(source, frames, "bgr8", calibration, host_timestamps=True)
+        for command, args in (("import", (source, self.path("in.mcap"))),
+                              ("export", (self.path("in.mcap"), self.path("out")))):
+            result = tilth("recording", command, *args)
+            self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(host_timestamps(self.path("out")),
+                         [(frame["index"], frame["host_ns"]) for frame in frames])
+        self.assertEqual(read_bytes(self.path("out/host_timestamps.csv")),
+                         read_bytes(os.path.join(source, "host_timestamps.csv")))
 
     def test_bad_input_says_what_and_where(self):
         folder = self.path("folder")

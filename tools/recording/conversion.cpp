@@ -97,7 +97,8 @@ std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder
     calibration = scratch.write(attachment->name, attachment->data);
   }
   InProcessGraph graph("tilth recording export");
-  graph.add_node("player", "mcap.player", {{"path", mcap_file.string()}});
+  graph.add_node("player", "mcap.player",
+                 {{"path", mcap_file.string()}, {"host_time", "recorded"}});
   graph.add_node("writer", "recording.image_folder_writer",
                  {{"path", folder.string()},
                   {"calibration", calibration.string()},
@@ -114,12 +115,16 @@ std::uint64_t import_from_folder(const fs::path& folder, const fs::path& mcap_fi
   const TemporaryFolder scratch;
   InProcessGraph graph("tilth recording import");
   graph.add_node("player", "recording.image_folder",
-                 {{"path", folder.string()}, {"on_missing", "stop"}});
+                 {{"path", folder.string()}, {"on_missing", "stop"}, {"host_time", "recorded"}});
+  // Without host_timestamps.csv (the recorded host times) the source stamps frames as it
+  // plays them, which says nothing of their capture: log times are then the device times.
+  const bool has_host_times = fs::exists(folder / "host_timestamps.csv");
   // Offline: every chunk compressed, however long it takes.
   graph.add_node("writer", "mcap.writer",
                  {{"path", mcap_file.string()},
                   {"calibration", folder_calibration(folder, scratch).string()},
-                  {"when_behind", "wait"}});
+                  {"when_behind", "wait"},
+                  {"log_time", has_host_times ? "host" : "device"}});
   if (!options.compression.empty()) {
     graph.set_from_option("writer", "compression", "--compression", options.compression);
   }

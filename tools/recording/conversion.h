@@ -1,6 +1,8 @@
 // `tilth recording export` and `import`: an MCAP recording to an image-folder recording
 // and back, each by running the recording stages in a graph of their own (player ->
-// writer), so the formats are read and written by the same code as in `tilth run`.
+// writer), so the formats are read and written by the same code as in `tilth run`. The
+// players are asked for the recorded host capture times (host_time: recorded), so those
+// carry through as every other field does.
 #pragma once
 
 #include <cstdint>

@@ -126,8 +126,12 @@ int main(int argc, char** argv) {
     for (const std::string port : {"raw", "color", "truth"}) {
       graph.add_edge("scene." + port, "writer." + port);
     }
-    graph.set_runtime({4, live ? tilth::FullPolicy::kDropOldest : tilth::FullPolicy::kBlock,
-                       tilth::ErrorPolicy::kStop});
+    // Live, a recorder graph (docs/mcap.md, "Recording live"): a second of frames in
+    // flight rides out the writer's stalls on a busy computer; beyond that the oldest
+    // frame waiting is dropped.
+    graph.set_runtime(
+        live ? tilth::RuntimeOptions{30, tilth::FullPolicy::kDropOldest, tilth::ErrorPolicy::kStop}
+             : tilth::RuntimeOptions{4, tilth::FullPolicy::kBlock, tilth::ErrorPolicy::kStop});
 
     const tilth::RunResult result = graph.run();
     if (result.failed) throw tilth::Error(result.failure);

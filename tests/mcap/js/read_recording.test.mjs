@@ -2,8 +2,9 @@
 // @mcap/core and its ROS 2 message decoder) reads a recording of synthetic.scene made by
 // mcap.writer, and checks it against the image-folder recording that
 // recording.image_folder_writer made of the same frames in the same graph: channel
-// names and schemas, message counts, sequence numbers and log times against frames.csv,
-// and every pixel of the first depth, colour and mask image against the PNGs.
+// names and schemas, message counts, sequence numbers, log times against
+// host_timestamps.csv and image timestamps against frames.csv, and every pixel of the
+// first depth, colour and mask image against the PNGs.
 import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -52,8 +53,10 @@ function record() {
 const dir = record();
 const file = path.join(dir, "scene.mcap");
 const folder = path.join(dir, "folder");
-const rows = fs.readFileSync(path.join(folder, "frames.csv"), "utf8").trim().split("\n").slice(1)
-  .map((line) => line.split(","));
+const readCsv = (name) => fs.readFileSync(path.join(folder, name), "utf8").trim().split("\n")
+  .slice(1).map((line) => line.split(","));
+const rows = readCsv("frames.csv");
+const hostRows = readCsv("host_timestamps.csv");
 
 const openReader = () => openMcap(file);
 
@@ -76,20 +79,26 @@ test("channels, schemas and message counts", async () => {
   assert.ok(reader.chunkIndexes.every((chunk) => chunk.compression === "zstd"));
 });
 
-test("sequence numbers and log times are the frames' ids and device times", async () => {
+test("sequence numbers are the frames' ids, log times their host capture times", async () => {
   const reader = await openReader();
   const raw = await messagesOn(reader, "/tof/raw");
   const color = await messagesOn(reader, "/color/image");
   const truth = await messagesOn(reader, "/truth");
+  const mask = await messagesOn(reader, "/truth/mask");
   const decodeTruth = decoderFor(reader, truth[0].channelId);
+  const decodeImage = decoderFor(reader, raw[0].channelId);
   assert.equal(rows.length, FRAMES);
+  assert.equal(hostRows.length, FRAMES);
   rows.forEach(([index, depthNs, colorNs], i) => {
-    assert.equal(raw[i].sequence, Number(index));
-    assert.equal(raw[i].logTime, BigInt(depthNs));
-    assert.equal(raw[i].publishTime, BigInt(depthNs));
-    assert.equal(color[i].sequence, Number(index));
-    assert.equal(color[i].logTime, BigInt(colorNs));
-    assert.equal(truth[i].logTime, BigInt(depthNs));
+    const [hostIndex, hostNs] = hostRows[i];
+    assert.equal(hostIndex, index);
+    for (const message of [raw[i], color[i], truth[i], mask[i]]) {
+      assert.equal(message.sequence, Number(index));
+      assert.equal(message.logTime, BigInt(hostNs));
+      assert.equal(message.publishTime, BigInt(hostNs));
+    }
+    assert.equal(stampNs(decodeImage(raw[i]).timestamp), BigInt(depthNs));
+    assert.equal(stampNs(decodeImage(color[i]).timestamp), BigInt(colorNs));
     assert.equal(decodeTruth(truth[i]).distance_mm, Number(rows[i][6]));
   });
 });
@@ -108,7 +117,8 @@ test("images decode as Foxglove decodes them, to the image-folder PNGs' pixels",
     assert.equal(image.encoding, want.encoding, topic);
     assert.equal(image.frame_id, want.frameId, topic);
     assert.deepEqual([image.width, image.height, image.step], want.size, topic);
-    assert.equal(stampNs(image.timestamp), message.logTime, topic);
+    assert.equal(stampNs(image.timestamp), BigInt(rows[0][topic === "/color/image" ? 2 : 1]),
+                 topic);
     const png = pngAsRawImageBytes(readPng(path.join(folder, want.folder, `${index}.png`)));
     assert.ok(Buffer.from(image.data).equals(png), `${topic}: pixels differ from the PNG`);
   }

@@ -1,10 +1,11 @@
 // The round trip simulate -> MCAP -> image folder -> MCAP, with the `tilth` commands a
 // user runs, checked by readers that share no code with Tilth (readers.mjs): both MCAP
 // files hold the same messages (sequence numbers = frame ids, log and publish times =
-// device times, and the very bytes: every pixel, image timestamp, frame_id and
-// encoding), the folder holds the same pixels, timestamps, ground truth (distance and
-// mask) and frame ids, and the calibration is the same file all the way. Exporting the
-// second MCAP file gives the folder again, file for file.
+// the host capture times, when the simulator rendered each frame, and the very bytes:
+// every pixel, image timestamp = device time, frame_id and encoding), the folder holds
+// the same pixels, device times (frames.csv), host times (host_timestamps.csv), ground
+// truth (distance and mask) and frame ids, and the calibration is the same file all the
+// way. Exporting the second MCAP file gives the folder again, file for file.
 //
 // A quarter-size rig keeps the simulator fast; case_c has straw, so the truth mask has
 // soil, residue and mixed pixels. Once with bgr8 colour, once with a Bayer mosaic.
@@ -44,11 +45,13 @@ function quarterRig() {
   return file;
 }
 
-function framesCsv(folder) {
-  const [header, ...lines] = fs.readFileSync(path.join(folder, "frames.csv"), "utf8").trim().split("\n");
+function readCsv(folder, name) {
+  const [header, ...lines] = fs.readFileSync(path.join(folder, name), "utf8").trim().split("\n");
   const names = header.split(",");
   return lines.map((line) => Object.fromEntries(line.split(",").map((v, i) => [names[i], v])));
 }
+
+const nowNs = () => BigInt(Date.now()) * 1000000n;
 
 function listFiles(folder) {
   return fs.readdirSync(folder, { recursive: true }).filter((name) =>
@@ -64,17 +67,21 @@ async function roundTrip(colorFormat) {
   const second = path.join(work, "imported.mcap");
   const again = path.join(work, "folder-again");
 
+  const simulationStart = nowNs();
   assert.match(tilth("simulate", first, "--preset", "case_c", "--frames", String(FRAMES),
                      "--seed", "11", "--calibration", calibration, "--color-format", colorFormat),
                new RegExp(`${FRAMES} frames \\(mcap\\)`));
+  const simulationEnd = nowNs();
   assert.match(tilth("recording", "export", first, folder), new RegExp(`${FRAMES} frames from`));
   assert.match(tilth("recording", "import", folder, second), new RegExp(`${FRAMES} frames from`));
   tilth("recording", "export", second, again);
 
   const a = await openMcap(first);
   const b = await openMcap(second);
-  const rows = framesCsv(folder);
+  const rows = readCsv(folder, "frames.csv");
   assert.equal(rows.length, FRAMES);
+  const hostRows = readCsv(folder, "host_timestamps.csv");
+  assert.deepEqual(hostRows.map((row) => row.index), rows.map((row) => row.index));
   const recording = JSON.parse(fs.readFileSync(path.join(folder, "recording.json")));
   assert.equal(recording.color_format, colorFormat);
 
@@ -104,10 +111,19 @@ async function roundTrip(colorFormat) {
     const truth = messages["/truth"][i];
     const mask = messages["/truth/mask"][i];
     assert.equal(BigInt(row.index), BigInt(raw.message.sequence), `frame ${i}: id`);
-    assert.equal(BigInt(row.depth_timestamp_ns), raw.message.logTime, `frame ${i}: depth time`);
-    assert.equal(BigInt(row.depth_timestamp_ns), stampNs(raw.decoded.timestamp));
-    assert.equal(BigInt(row.color_timestamp_ns), color.message.logTime, `frame ${i}: colour time`);
-    assert.equal(BigInt(row.color_timestamp_ns), stampNs(color.decoded.timestamp));
+    // Log and publish times: the host capture time, the same for every message of the
+    // frame, on the wall clock while the simulator ran; images keep their device times.
+    const host = BigInt(hostRows[i].host_timestamp_ns);
+    assert.ok(host >= simulationStart && host <= simulationEnd, `frame ${i}: host time ${host}`);
+    if (i > 0) assert.ok(host > BigInt(hostRows[i - 1].host_timestamp_ns), `frame ${i}: host time`);
+    for (const { message } of [raw, color, truth, mask]) {
+      assert.equal(message.logTime, host, `frame ${i}: log time`);
+      assert.equal(message.publishTime, host, `frame ${i}: publish time`);
+    }
+    assert.equal(stampNs(raw.decoded.timestamp), BigInt(row.depth_timestamp_ns), `frame ${i}: depth time`);
+    assert.equal(stampNs(color.decoded.timestamp), BigInt(row.color_timestamp_ns),
+                 `frame ${i}: colour time`);
+    assert.notEqual(host, BigInt(row.depth_timestamp_ns));
     assert.equal(color.decoded.encoding, colorFormat);
     assert.equal(Number(row.ground_truth_mm), truth.decoded.distance_mm, `frame ${i}: truth`);
     assert.equal(truth.decoded.distance_mm, 518);
