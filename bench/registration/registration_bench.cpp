@@ -8,6 +8,7 @@
 
 #include "projection.h"
 #include "projective.h"
+#include "row_kernels.h"
 #include "tilth/frame.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
@@ -53,29 +54,38 @@ Packet color_frame(PixelFormat format) {
 
 const char* interpolation_name(std::int64_t bilinear) { return bilinear ? "bilinear" : "nearest"; }
 
-// Args: pixel format, bilinear (0/1).
+// The stage's parameters for the arguments: pixel format (ignored), bilinear (0/1), the
+// index of the instruction-set level among those the CPU runs.
+nlohmann::json registration_params(const benchmark::State& state) {
+  return {{"occlusion_tolerance_mm", 10.0},
+          {"interpolation", interpolation_name(state.range(1))},
+          {"instruction_set", available_row_kernels()[state.range(2)]->level}};
+}
+
+std::string label(const benchmark::State& state) {
+  return std::string(to_string(static_cast<PixelFormat>(state.range(0)))) + ", " +
+         interpolation_name(state.range(1)) + ", " + available_row_kernels()[state.range(2)]->level;
+}
+
+// Args: see registration_params.
 void BM_Registration(benchmark::State& state) {
   cv::setNumThreads(0);  // one core: OpenCV's own threads (demosaicing) off too
   const auto format = static_cast<PixelFormat>(state.range(0));
   const auto projection = make(depth::describe_projection(), nlohmann::json::object());
-  const auto registration = make(
-      describe_projective(),
-      {{"occlusion_tolerance_mm", 10.0}, {"interpolation", interpolation_name(state.range(1))}});
+  const auto registration = make(describe_projective(), registration_params(state));
   const Packet raw = raw_frame();
   const std::vector<Packet> inputs = {
       Packet(FrameInfo{}, run(*projection, std::span<const Packet>(&raw, 1))), color_frame(format)};
   for (auto _ : state) benchmark::DoNotOptimize(run(*registration, inputs).get());
-  state.SetLabel(std::string(to_string(format)) + ", " + interpolation_name(state.range(1)));
+  state.SetLabel(label(state));
 }
 
-// Args: pixel format, bilinear (0/1).
+// Args: see registration_params.
 void BM_ProjectionAndRegistration(benchmark::State& state) {
   cv::setNumThreads(0);
   const auto format = static_cast<PixelFormat>(state.range(0));
   const auto projection = make(depth::describe_projection(), nlohmann::json::object());
-  const auto registration = make(
-      describe_projective(),
-      {{"occlusion_tolerance_mm", 10.0}, {"interpolation", interpolation_name(state.range(1))}});
+  const auto registration = make(describe_projective(), registration_params(state));
   const Packet raw = raw_frame();
   std::vector<Packet> inputs = {Packet(), color_frame(format)};
   for (auto _ : state) {
@@ -83,12 +93,16 @@ void BM_ProjectionAndRegistration(benchmark::State& state) {
     benchmark::DoNotOptimize(run(*registration, inputs).get());
     inputs[0] = Packet();  // the depth image goes back to its pool
   }
-  state.SetLabel(std::string(to_string(format)) + ", " + interpolation_name(state.range(1)));
+  state.SetLabel(label(state));
 }
 
 void formats(benchmark::internal::Benchmark* b) {
   for (const auto format : {PixelFormat::kBgr8, PixelFormat::kBayerRggb8}) {
-    for (const int bilinear : {0, 1}) b->Args({static_cast<int>(format), bilinear});
+    for (const int bilinear : {0, 1}) {
+      for (std::size_t level = 0; level < available_row_kernels().size(); ++level) {
+        b->Args({static_cast<int>(format), bilinear, static_cast<std::int64_t>(level)});
+      }
+    }
   }
 }
 

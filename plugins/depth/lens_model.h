@@ -19,8 +19,9 @@ struct Distortion {
   T k1, k2, p1, p2, k3;
   T one, two;
 
-  // Undistorted (x, y) -> distorted, in place.
-  void apply(T& x, T& y) const {
+  // Undistorted (x, y) -> distorted, in place. Always inlined: vector code compiled for
+  // several instruction sets must not share one out-of-line copy.
+  [[gnu::always_inline]] void apply(T& x, T& y) const {
     const T r2 = x * x + y * y;
     const T radial = one + r2 * (k1 + r2 * (k2 + r2 * k3));
     const T two_xy = two * x * y;

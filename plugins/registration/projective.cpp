@@ -29,11 +29,11 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "color_sampler.h"
 #include "depth_to_color.h"
+#include "row_kernels.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/color_image.h"
@@ -43,8 +43,6 @@
 
 namespace tilth::registration {
 namespace {
-
-constexpr int kLanes = 4;  // cv::v_float32x4
 
 std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height) + " px";
@@ -65,84 +63,74 @@ struct OcclusionCells {
   int size;
   int columns;
   int rows;
+
+  CellGrid grid() const { return {size, columns, columns * rows}; }
 };
 
-// One row of located depth pixels, as plain pointers: the registration writes bytes, and
-// through a byte pointer the compiler must assume any memory changed, so everything read
-// per pixel is held in locals, not reached through objects.
+// One row of depth pixels as the colour camera sees them, in plain arrays: the
+// registration writes bytes, and through a byte pointer the compiler must assume any
+// memory changed, so everything read per pixel is held in locals, not reached through
+// objects.
 struct LocatedRow {
   const float* u;  // colour pixel
   const float* v;
   const float* depth_mm;  // along the colour axis; NaN: not in the colour image
-  const int* offset;      // of the nearest colour pixel in the colour image, in bytes
-  const int* cell;        // -1: not in the colour image
+  const int* key;         // of the sampler's pixels (Addressing)
+  const int* cell;        // CellGrid::outside: not in the colour image
 };
 
 // What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
-// colour camera sees them (located once, read by both passes), and the demosaiced colour
-// image.
+// colour camera sees them (located once, read by both passes; their colour pixels only
+// for bilinear sampling, which reads them in the second) and the demosaiced colour image
+// for bilinear sampling of a mosaic.
 struct Scratch {
-  cv::Mat nearest_mm;  // CV_32FC1 per cell: the nearest depth along the colour axis
-  std::vector<float> color_u, color_v, color_depth;  // rows of DepthToColor::row_capacity()
-  std::vector<int> offset, cell;
-  cv::Mat demosaiced;  // CV_8UC3, from a Bayer mosaic
+  std::vector<float> nearest_mm;        // per cell: the nearest depth along the colour axis
+  std::vector<float> color_u, color_v;  // a row, or every row for bilinear sampling
+  std::vector<float> color_depth;       // every row, of DepthToColor::row_capacity()
+  std::vector<int> key, cell;
+  cv::Mat demosaiced;  // CV_8UC3
 
-  void prepare(const DepthToColor& map, const OcclusionCells& cells) {
-    const auto n = static_cast<std::size_t>(map.row_capacity()) * map.depth_height();
-    for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(n);
-    for (auto* values : {&offset, &cell}) values->resize(n);
-    reuse_or_create(nearest_mm, cells.rows, cells.columns, CV_32FC1);
-    // Not Mat::setTo, which allocates a scratch buffer every call.
-    std::fill_n(nearest_mm.ptr<float>(), nearest_mm.total(),
-                std::numeric_limits<float>::infinity());
+  void prepare(const DepthToColor& map, const OcclusionCells& cells, bool bilinear) {
+    const auto row = static_cast<std::size_t>(map.row_capacity());
+    const auto frame = row * static_cast<std::size_t>(map.depth_height());
+    for (auto* values : {&color_u, &color_v}) values->resize(bilinear ? frame : row);
+    color_depth.resize(frame);
+    for (auto* values : {&key, &cell}) values->resize(frame);
+    nearest_mm.assign(static_cast<std::size_t>(cells.grid().outside) + 1,
+                      std::numeric_limits<float>::infinity());
   }
 
   LocatedRow row(const DepthToColor& map, int v) const {
-    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
-    return {color_u.data() + start, color_v.data() + start, color_depth.data() + start,
-            offset.data() + start, cell.data() + start};
+    const std::size_t start = start_of(map, v);
+    const std::size_t uv = uv_start_of(start);
+    return {color_u.data() + uv, color_v.data() + uv, color_depth.data() + start,
+            key.data() + start, cell.data() + start};
   }
 
-  // Projects depth row `v` and finds each point's nearest colour pixel (as its byte
-  // offset in an image of `step` bytes per row and `pixel_bytes` per pixel; int32 holds
-  // any image below 2 GB) and its cell.
+  // Projects depth row `v` and finds each point's pixels for the sampler and its cell.
   LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                    int v, std::ptrdiff_t step, int pixel_bytes) {
-    const auto start = static_cast<std::size_t>(v) * map.row_capacity();
-    float* const u_row = color_u.data() + start;
-    float* const v_row = color_v.data() + start;
-    float* const depth_row = color_depth.data() + start;
-    int* const offset_row = offset.data() + start;
-    int* const cell_row = cell.data() + start;
-    map.project_row(v, depth.ptr<float>(v), u_row, v_row, depth_row);
-    using cv::v_float32x4;
-    using cv::v_int32x4;
-    const v_float32x4 half = cv::v_setall_f32(0.5f);
-    const v_float32x4 per_cell = cv::v_setall_f32(1.0f / static_cast<float>(cells.size));
-    const v_int32x4 columns = cv::v_setall_s32(cells.columns);
-    const v_int32x4 row_bytes = cv::v_setall_s32(static_cast<int>(step));
-    const v_int32x4 bytes = cv::v_setall_s32(pixel_bytes);
-    const v_int32x4 none = cv::v_setall_s32(-1);
-    for (int i = 0; i < map.row_capacity(); i += kLanes) {
-      // Shown points have 0 <= u + 0.5 < width (DepthToColor::kEdgeMarginPx): truncation
-      // rounds to the nearest pixel, and floor((u + 0.5) / size) is the cell.
-      const v_float32x4 x = cv::v_load(u_row + i) + half;
-      const v_float32x4 y = cv::v_load(v_row + i) + half;
-      const v_float32x4 depth_mm = cv::v_load(depth_row + i);
-      cv::v_store(offset_row + i, cv::v_trunc(y) * row_bytes + cv::v_trunc(x) * bytes);
-      const v_int32x4 index =
-          cv::v_muladd(cv::v_trunc(y * per_cell), columns, cv::v_trunc(x * per_cell));
-      const v_int32x4 shown = cv::v_reinterpret_as_s32(depth_mm == depth_mm);  // not NaN
-      cv::v_store(cell_row + i, cv::v_select(shown, index, none));
-    }
+                    int v, const Addressing& addressing) {
+    const std::size_t start = start_of(map, v);
+    const std::size_t uv = uv_start_of(start);
+    map.project_row(v, depth.ptr<float>(v), color_u.data() + uv, color_v.data() + uv,
+                    color_depth.data() + start);
+    map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
+                         map.row_capacity(), color_u.data() + uv, color_v.data() + uv,
+                         color_depth.data() + start, key.data() + start, cell.data() + start);
     return row(map, v);
   }
+
+ private:
+  static std::size_t start_of(const DepthToColor& map, int v) {
+    return static_cast<std::size_t>(v) * static_cast<std::size_t>(map.row_capacity());
+  }
+  std::size_t uv_start_of(std::size_t start) const { return color_u.size() > start ? start : 0; }
 };
 
 template <bool kBilinear, class Sampler>
 Bgr sample(const Sampler& sampler, const LocatedRow& row, int i, int width, int height) {
   if constexpr (!kBilinear) {
-    return sampler.at(row.offset[i]);
+    return sampler.at(row.key[i]);
   } else {
     const float u = row.u[i];
     const float v = row.v[i];
@@ -172,42 +160,50 @@ template <bool kBilinear, class Sampler>
 void register_frame(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
                     const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
                     RegisteredColor& out) {
-  scratch.prepare(map, cells);
+  scratch.prepare(map, cells, kBilinear);
   const Sampler colors = sampler;  // a local: see LocatedRow
-  float* const nearest_mm = scratch.nearest_mm.ptr<float>();
+  const Addressing addressing = colors.addressing();
+  float* const nearest_mm = scratch.nearest_mm.data();
+  const int outside = cells.grid().outside;
   const int width = map.depth_width();
   const int height = map.depth_height();
   const int color_width = map.color_width();
   const int color_height = map.color_height();
 
-  for (int v = 0; v < height; ++v) {  // the nearest point of each cell
-    const LocatedRow row =
-        scratch.locate(map, cells, depth, v, colors.step(), Sampler::kPixelBytes);
+  // The nearest point of each cell. Points not shown have NaN depth, which std::min
+  // ignores: the outside cell stays at infinity.
+  for (int v = 0; v < height; ++v) {
+    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing);
     for (int u = 0; u < width; ++u) {
-      const int cell = row.cell[u];
-      if (cell >= 0) nearest_mm[cell] = std::min(nearest_mm[cell], row.depth_mm[u]);
+      float& nearest = nearest_mm[row.cell[u]];
+      nearest = std::min(nearest, row.depth_mm[u]);
     }
   }
 
+  // Without branches on the status, which changes unpredictably at straw edges: a NaN
+  // depth is never visible, and nearest sampling may read the pixel of any key.
   for (int v = 0; v < height; ++v) {
     const LocatedRow row = scratch.row(map, v);
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);
     for (int u = 0; u < width; ++u) {
-      Bgr color{0, 0, 0};
       const int cell = row.cell[u];
-      if (cell < 0) {
-        status[u] = std::isnan(z[u]) ? RegisteredColor::kNoDepth : RegisteredColor::kOutsideColor;
-      } else if (row.depth_mm[u] > nearest_mm[cell] + occlusion_tolerance_mm) {
-        status[u] = RegisteredColor::kOccluded;
+      const bool visible = row.depth_mm[u] <= nearest_mm[cell] + occlusion_tolerance_mm;
+      status[u] = visible            ? RegisteredColor::kValid
+                  : cell != outside  ? RegisteredColor::kOccluded
+                  : std::isnan(z[u]) ? RegisteredColor::kNoDepth
+                                     : RegisteredColor::kOutsideColor;
+      Bgr color{0, 0, 0};
+      if constexpr (kBilinear) {
+        if (visible) color = sample<true>(colors, row, u, color_width, color_height);
       } else {
-        status[u] = RegisteredColor::kValid;
-        color = sample<kBilinear>(colors, row, u, color_width, color_height);
+        color = sample<false>(colors, row, u, color_width, color_height);
       }
-      bgr[3 * u] = static_cast<std::uint8_t>(color.b);
-      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g);
-      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r);
+      const int keep = visible ? 0xff : 0;
+      bgr[3 * u] = static_cast<std::uint8_t>(color.b & keep);
+      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g & keep);
+      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r & keep);
     }
   }
 }
@@ -234,11 +230,18 @@ class ProjectiveRegistration final : public Transform {
                               *out);
       }
     };
-    // OpenCV's SIMD demosaicing of the whole image costs less than demosaicing only the
-    // pixels read, one at a time.
-    const auto run_demosaiced = [&](int code) {
-      cv::cvtColor(color.pixels, scratch->demosaiced, code);
-      run(BgrSampler(scratch->demosaiced));
+    // Nearest sampling reads a mosaic at the quad nearest each point; bilinear sampling
+    // blends demosaiced pixels. OpenCV names a mosaic by its second row's second and
+    // third pixels, one pixel off the usual naming by the top-left 2x2 tile.
+    const auto run_mosaic = [&](std::string_view tile, int opencv_code) {
+      if (bilinear_) {
+        cv::cvtColor(color.pixels, scratch->demosaiced, opencv_code);
+        register_frame<true>(map_, cells_, depth, BgrSampler(scratch->demosaiced),
+                             occlusion_tolerance_mm_, *scratch, *out);
+      } else {
+        register_frame<false>(map_, cells_, depth, BayerQuadSampler(color.pixels, tile),
+                              occlusion_tolerance_mm_, *scratch, *out);
+      }
     };
     switch (color.format) {
       case PixelFormat::kBgr8:
@@ -250,19 +253,17 @@ class ProjectiveRegistration final : public Transform {
       case PixelFormat::kMono8:
         run(MonoSampler(color.pixels));
         break;
-      // OpenCV names a mosaic by its second row's second and third pixels, one pixel
-      // off the usual naming by the top-left 2x2 tile.
       case PixelFormat::kBayerRggb8:
-        run_demosaiced(cv::COLOR_BayerBG2BGR);
+        run_mosaic("RGGB", cv::COLOR_BayerBG2BGR);
         break;
       case PixelFormat::kBayerBggr8:
-        run_demosaiced(cv::COLOR_BayerRG2BGR);
+        run_mosaic("BGGR", cv::COLOR_BayerRG2BGR);
         break;
       case PixelFormat::kBayerGrbg8:
-        run_demosaiced(cv::COLOR_BayerGB2BGR);
+        run_mosaic("GRBG", cv::COLOR_BayerGB2BGR);
         break;
       case PixelFormat::kBayerGbrg8:
-        run_demosaiced(cv::COLOR_BayerGR2BGR);
+        run_mosaic("GBRG", cv::COLOR_BayerGR2BGR);
         break;
     }
     frame.set_output(0, std::move(out));
@@ -274,7 +275,7 @@ class ProjectiveRegistration final : public Transform {
   ProjectiveRegistration(const StageContext& context, const std::string& file,
                          const RigCalibration& rig)
       : file_(file),
-        map_(rig, file),
+        map_(rig, file, row_kernels(context.params.string("instruction_set"))),
         cells_(rig),
         occlusion_tolerance_mm_(
             static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
@@ -332,7 +333,11 @@ StageDescriptor describe_projective() {
           .describe("a point this much farther than the nearest one seen at the same colour "
                     "pixels is occluded"),
       ParamSpec::choice("interpolation", {"nearest", "bilinear"}, "nearest")
-          .describe("colour sampling: nearest keeps measured colours, bilinear blends four"),
+          .describe("colour sampling: nearest keeps measured colours (of a Bayer mosaic: the "
+                    "2x2 quad nearest the point), bilinear blends four demosaiced pixels"),
+      ParamSpec::choice("instruction_set", row_kernel_levels(), "auto")
+          .describe("the vector loops' instruction set: auto = the widest this CPU runs; "
+                    "others for comparison"),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<ProjectiveRegistration>();

@@ -24,7 +24,8 @@ TEST(RegistrationPlugin, TheLibraryProvidesTheProjectiveStage) {
   const StageContext context{"registration",
                              Params(nlohmann::json{{"calibration", calibration},
                                                    {"occlusion_tolerance_mm", 10.0},
-                                                   {"interpolation", "nearest"}}),
+                                                   {"interpolation", "nearest"},
+                                                   {"instruction_set", "auto"}}),
                              Logger("registration"),
                              {}};
   StageInstance instance = registry.create("registration.projective", context);

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <span>
 
 #include <gtest/gtest.h>
@@ -25,6 +26,7 @@
 #include "depth_to_color.h"
 #include "projective.h"
 #include "reference_geometry.h"
+#include "row_kernels.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
 #include "tilth/messages/color_image.h"
@@ -80,11 +82,13 @@ json rotation(double x_deg, double y_deg, double z_deg) {
 
 std::unique_ptr<Transform> make_registration(const fs::path& calibration,
                                              const std::string& interpolation = "nearest",
-                                             double occlusion_tolerance_mm = 10.0) {
+                                             double occlusion_tolerance_mm = 10.0,
+                                             const std::string& instruction_set = "auto") {
   const StageContext context{"registration",
                              Params(json{{"calibration", calibration.string()},
                                          {"occlusion_tolerance_mm", occlusion_tolerance_mm},
-                                         {"interpolation", interpolation}}),
+                                         {"interpolation", interpolation},
+                                         {"instruction_set", instruction_set}}),
                              Logger("registration"),
                              {}};
   std::unique_ptr<Stage> stage = describe_projective().create(context);
@@ -186,9 +190,10 @@ struct MappedRow {
 // Compares a registration of a scene without occlusion, nearest sampling of
 // coordinate_image(), with the reference.
 Agreement compare(const json& document, const fs::path& file, const cv::Mat& depth,
-                  const std::vector<ref::Vec3>& rays, const RegisteredColor& out) {
+                  const std::vector<ref::Vec3>& rays, const RegisteredColor& out,
+                  const std::string& instruction_set = "auto") {
   const ref::Rig rig = ref::rig_from(document);
-  const DepthToColor map(load_calibration(file), file.string());
+  const DepthToColor map(load_calibration(file), file.string(), row_kernels(instruction_set));
   const Real right = rig.color.width - 0.5L;
   const Real bottom = rig.color.height - 0.5L;
   Agreement a;
@@ -243,18 +248,29 @@ void expect_agreement(const Agreement& a, int min_in_image) {
 
 ref::Vec3 tilted_normal() { return {0.18L, -0.36L, 1.0L}; }  // 10 and 20 degrees
 
+// Every instruction-set level this CPU runs (row_kernels.h) is held to the reference.
+std::vector<std::string> levels() {
+  std::vector<std::string> names;
+  for (const RowKernels* kernels : available_row_kernels()) names.emplace_back(kernels->level);
+  return names;
+}
+
 TEST(ProjectiveRegistration, TiltedPlaneMatchesTheReferenceProjection) {
   const json document = paper_rig();
   const ref::Rig rig = ref::rig_from(document);
   const auto rays = depth_rays(rig);
   const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
-  const auto out = register_color(*make_registration(kPaperRig), depth, coordinate_image());
-  const Agreement a = compare(document, kPaperRig, depth, rays, *out);
-  // The colour camera sees most of the ToF image: all but a band on the side away
-  // from the baseline.
-  expect_agreement(a, 250000);
-  std::cout << "paper rig, tilted plane: max mapping error " << a.max_mapping_error_px
-            << " px over " << a.in_image << " pixels\n";
+  for (const std::string& level : levels()) {
+    SCOPED_TRACE(level);
+    const auto out = register_color(*make_registration(kPaperRig, "nearest", 10.0, level), depth,
+                                    coordinate_image());
+    const Agreement a = compare(document, kPaperRig, depth, rays, *out, level);
+    // The colour camera sees most of the ToF image: all but a band on the side away
+    // from the baseline.
+    expect_agreement(a, 250000);
+    std::cout << "paper rig, tilted plane, " << level << ": max mapping error "
+              << a.max_mapping_error_px << " px over " << a.in_image << " pixels\n";
+  }
 }
 
 TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProjection) {
@@ -267,11 +283,27 @@ TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProj
   const ref::Rig rig = ref::rig_from(document);
   const auto rays = depth_rays(rig);
   const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
-  const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
-  const Agreement a = compare(document, file.path(), depth, rays, *out);
-  expect_agreement(a, 200000);
-  std::cout << "rotated rig with distortion: max mapping error " << a.max_mapping_error_px
-            << " px over " << a.in_image << " pixels\n";
+  for (const std::string& level : levels()) {
+    SCOPED_TRACE(level);
+    const auto out = register_color(*make_registration(file.path(), "nearest", 10.0, level), depth,
+                                    coordinate_image());
+    const Agreement a = compare(document, file.path(), depth, rays, *out, level);
+    expect_agreement(a, 200000);
+    std::cout << "rotated rig with distortion, " << level << ": max mapping error "
+              << a.max_mapping_error_px << " px over " << a.in_image << " pixels\n";
+  }
+}
+
+TEST(ProjectiveRegistration, AnInstructionSetTheCpuDoesNotRunIsRefused) {
+  std::string runnable;
+  for (const std::string& level : levels()) runnable += (runnable.empty() ? "" : ", ") + level;
+  try {
+    make_registration(kPaperRig, "nearest", 10.0, "x86-64-v9");
+    ADD_FAILURE() << "x86-64-v9 was accepted";
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "this CPU does not run instruction set x86-64-v9; it runs " + runnable);
+  }
 }
 
 TEST(ProjectiveRegistration, PixelsOutsideTheColourImageAreFlaggedAndBlack) {
@@ -498,6 +530,33 @@ TEST(ProjectiveRegistration, EachBayerPatternGivesBackAKnownColour) {
   }
 }
 
+TEST(ProjectiveRegistration, NearestSamplingOfAMosaicReadsTheQuadNearestThePoint) {
+  // Every 2x2 quad of a mosaic holds one red, one blue and two greens, whichever pixel it
+  // starts on: with the two green sites at 100 and 51, each registered pixel is (blue,
+  // (100 + 51 + 1) / 2, red) exactly, for every pattern and every phase of the quad.
+  const auto stage = make_registration(kPaperRig);
+  const ref::Rig rig = ref::rig_from(paper_rig());
+  const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
+  for (const PixelFormat format : kBayerFormats) {
+    cv::Mat mosaic_image(1024, 1280, CV_8UC1);
+    for (int y = 0; y < mosaic_image.rows; ++y) {
+      for (int x = 0; x < mosaic_image.cols; ++x) {
+        const char site = tile(format)[static_cast<std::size_t>((y % 2) * 2 + x % 2)];
+        mosaic_image.at<std::uint8_t>(y, x) = site == 'R'   ? 210
+                                              : site == 'B' ? 30
+                                              : y % 2       ? 51
+                                                            : 100;
+      }
+    }
+    const auto out = register_color(*stage, depth, mosaic_image, format);
+    const cv::Mat valid = out->status == RegisteredColor::kValid;
+    EXPECT_GT(cv::countNonZero(valid), 250000) << to_string(format);
+    cv::Mat as_expected;
+    cv::inRange(out->bgr, cv::Scalar(30, 76, 210), cv::Scalar(30, 76, 210), as_expected);
+    EXPECT_EQ(cv::countNonZero(valid & ~as_expected), 0) << to_string(format);
+  }
+}
+
 TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
   cv::Mat smooth(1024, 1280, CV_8UC3);
   for (int y = 0; y < smooth.rows; ++y) {
@@ -510,12 +569,16 @@ TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
   }
   const ref::Rig rig = ref::rig_from(paper_rig());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
-  // Bilinear demosaicing reproduces a linear ramp exactly; this image's curvature is at
+  // Bilinear: demosaicing reproduces a linear ramp exactly; this image's curvature is at
   // most 100 / 60^2 = 0.03 levels per pixel^2, far below a level over the 1-pixel
   // neighbourhood, so what remains is the rounding of the image (0.5 level) and of the
   // neighbour averages (0.5 level) and of bilinear sampling (0.5 level): 2 levels.
-  constexpr double kLevels = 2;
-  for (const std::string interpolation : {"nearest", "bilinear"}) {
+  // Nearest: each channel comes from its site in the quad nearest the point, at most one
+  // pixel from the bgr8 image's nearest pixel in x and in y; blue changes by at most
+  // 100 / 60 + 100 / 80 = 2.9 levels over that, plus the rounding of the image and of
+  // the greens' mean: 4 levels.
+  const std::map<std::string, double> levels_off = {{"nearest", 4}, {"bilinear", 2}};
+  for (const auto& [interpolation, max_levels] : levels_off) {
     const auto stage = make_registration(kPaperRig, interpolation);
     const auto bgr = register_color(*stage, depth, smooth);
     const cv::Mat valid = bgr->status == RegisteredColor::kValid;
@@ -523,7 +586,7 @@ TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
     for (const PixelFormat format : kBayerFormats) {
       const auto bayer = register_color(*stage, depth, mosaic(smooth, format), format);
       EXPECT_EQ(cv::countNonZero(bayer->status != bgr->status), 0);
-      EXPECT_LE(cv::norm(bayer->bgr, bgr->bgr, cv::NORM_INF, valid), kLevels)
+      EXPECT_LE(cv::norm(bayer->bgr, bgr->bgr, cv::NORM_INF, valid), max_levels)
           << to_string(format) << ", " << interpolation;
     }
     cv::Mat rgb;
@@ -615,7 +678,7 @@ struct LinearisationError {
 
 LinearisationError linearisation_error(const json& document, const fs::path& file, Real z) {
   const ref::Rig rig = ref::rig_from(document);
-  const DepthToColor map(load_calibration(file), file.string());
+  const DepthToColor map(load_calibration(file), file.string(), row_kernels("auto"));
   const Linearised paper(rig);
   LinearisationError e;
   const std::vector<float> depth_row(static_cast<std::size_t>(rig.depth.width),
