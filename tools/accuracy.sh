@@ -3,18 +3,21 @@
 # cases) into image-folder recordings, runs graphs/paper.json on each, and tabulates
 # the distance error against ground truth like the paper's Table 2.
 # usage: bash tools/accuracy.sh [FRAMES_PER_CASE [REPORT OPTIONS]] > docs/accuracy.md
-#   (after building; TILTH=path/to/tilth to use another build)
+#   (after building; TILTH=path/to/tilth to use another build, COLOR_FORMAT=bayer_rggb8
+#   to have the colour camera deliver a Bayer mosaic instead of bgr8)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-20}
 shift || true
 tilth=${TILTH:-build/bin/tilth}
+color_format=${COLOR_FORMAT:-bgr8}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cases="case_a case_b case_c case_d case_e wet_straw covered"
 for preset in $cases; do
   "$tilth" run graphs/simulate.json --quiet --set scene.preset=$preset \
-    --set scene.frames=$frames --set recording.path="$work/$preset" >&2
+    --set scene.frames=$frames --set scene.color_format="$color_format" \
+    --set recording.path="$work/$preset" >&2
   "$tilth" run graphs/paper.json --quiet --set input.path="$work/$preset" \
     --set output.path="$work/$preset.csv" >&2
 done

@@ -24,7 +24,7 @@ constexpr int kLanes = 16;
 #elif defined(__AVX__)
 constexpr int kLanes = 8;
 #else
-constexpr int kLanes = 4;  // SSE2, NEON
+constexpr int kLanes = 4;  // SSE2, SSE4.2, NEON
 #endif
 static_assert(kRowLanes % kLanes == 0, "rows are whole vectors of every level");
 

@@ -12,6 +12,9 @@ namespace baseline {
 extern const RowKernels kRowKernels;
 }
 #ifdef TILTH_KERNEL_LEVELS_X86_64
+namespace x86_64_v2 {
+extern const RowKernels kRowKernels;
+}
 namespace x86_64_v3 {
 extern const RowKernels kRowKernels;
 }
@@ -32,6 +35,7 @@ std::vector<Level> built_levels() {
 #ifdef TILTH_KERNEL_LEVELS_X86_64
       {&x86_64_v4::kRowKernels, __builtin_cpu_supports("x86-64-v4") != 0},
       {&x86_64_v3::kRowKernels, __builtin_cpu_supports("x86-64-v3") != 0},
+      {&x86_64_v2::kRowKernels, __builtin_cpu_supports("x86-64-v2") != 0},
 #endif
       {&baseline::kRowKernels, true}};
 }
