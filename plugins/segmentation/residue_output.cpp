@@ -1,10 +1,12 @@
 #include "residue_output.h"
 
-#include <limits>
+#include <algorithm>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
 
+#include "bit_mask.h"
+#include "residue_rows.h"
 #include "tilth/error.h"
 
 namespace tilth::segmentation {
@@ -12,11 +14,6 @@ namespace {
 
 std::string size_text(const cv::Mat& image) {
   return std::to_string(image.cols) + "x" + std::to_string(image.rows);
-}
-
-cv::Mat square_kernel(std::int64_t radius_px) {
-  const int side = 2 * static_cast<int>(radius_px) + 1;
-  return cv::getStructuringElement(cv::MORPH_RECT, {side, side});
 }
 
 }  // namespace
@@ -96,30 +93,40 @@ void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing) {
 
 ResidueOutput::ResidueOutput(const Params& params)
     : dilation_px_(static_cast<int>(params.integer("dilation_px"))),
-      kernel_(square_kernel(dilation_px_)),
-      speckle_kernel_(square_kernel(params.integer("speckle_px"))),
-      despeckle_(params.integer("speckle_px") > 0) {}
+      speckle_px_(static_cast<int>(params.integer("speckle_px"))) {}
 
-void ResidueOutput::emit(Frame& frame, cv::Mat& residue, const cv::Mat& not_residue,
+void ResidueOutput::emit(Frame& frame, const cv::Mat& residue, const cv::Mat& not_residue,
                          const cv::Mat& unknown, const cv::Mat& depth_mm) {
   auto mask = masks_.acquire();
   auto soil = soil_depths_.acquire();
-  reuse_or_create(mask->values, depth_mm.rows, depth_mm.cols, CV_8UC1);
-  reuse_or_create(soil->mm, depth_mm.rows, depth_mm.cols, CV_32FC1);
+  const int rows = depth_mm.rows;
+  const int cols = depth_mm.cols;
+  reuse_or_create(mask->values, rows, cols, CV_8UC1);
+  reuse_or_create(soil->mm, rows, cols, CV_32FC1);
 
-  if (!not_residue.empty()) cv::subtract(residue, not_residue, residue);  // 255 - 255 = 0
-  if (despeckle_) cv::morphologyEx(residue, residue, cv::MORPH_OPEN, speckle_kernel_);
-  if (dilation_px_ > 0) {
-    cv::dilate(residue, mask->values, kernel_);
-  } else {
-    residue.copyTo(mask->values);
+  // As segmentation.color_threshold does it: bit masks, 64 pixels to a word.
+  thread_local BitMask residue_bits, unknown_bits, morphology;
+  residue_bits.resize(rows, cols);
+  unknown_bits.resize(rows, cols);
+  for (int y = 0; y < rows; ++y) {
+    std::uint64_t* residue_row = residue_bits.row(y);
+    std::uint64_t* unknown_row = unknown_bits.row(y);
+    for (int x = 0, word = 0; x < cols; x += 64, ++word) {
+      const int count = std::min(64, cols - x);
+      std::uint64_t bits = marked_bits(residue.ptr<std::uint8_t>(y) + x, count);
+      if (!not_residue.empty()) bits &= ~marked_bits(not_residue.ptr<std::uint8_t>(y) + x, count);
+      residue_row[word] = bits;
+      unknown_row[word] = marked_bits(unknown.ptr<std::uint8_t>(y) + x, count);
+    }
   }
-  mask->values.setTo(ResidueMask::kUnknown, unknown);
-
-  thread_local cv::Mat soil_pixels;
-  cv::compare(mask->values, ResidueMask::kSoil, soil_pixels, cv::CMP_EQ);
-  soil->mm.setTo(std::numeric_limits<float>::quiet_NaN());
-  depth_mm.copyTo(soil->mm, soil_pixels);
+  // An opening (erosion, then dilation by the same square) drops the specks; its
+  // dilation and the edge dilation that follows add up to one square.
+  residue_bits.erode(speckle_px_, morphology);
+  residue_bits.dilate(speckle_px_ + dilation_px_, morphology);
+  for (int y = 0; y < rows; ++y) {
+    write_residue_row(unknown_bits.row(y), residue_bits.row(y), depth_mm.ptr<float>(y), cols,
+                      mask->values.ptr<std::uint8_t>(y), soil->mm.ptr<float>(y));
+  }
 
   frame.set_output(kMask, mask);
   frame.set_output(kSoilDepth, soil);

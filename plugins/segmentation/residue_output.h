@@ -48,19 +48,17 @@ class ResidueOutput {
   // Reads dilation_px and speckle_px.
   explicit ResidueOutput(const Params& params);
 
-  // `residue` (CV_8UC1, 255/0) is what the variant found, and is consumed. Pixels marked
-  // in `not_residue` (if not empty) are taken out of it first, so they cannot grow into their
-  // neighbours; specks narrower than 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels
+  // `residue` (CV_8UC1, 255/0) is what the variant found. Pixels marked in `not_residue`
+  // (if not empty) are taken out of it first, so they cannot grow into their neighbours;
+  // specks narrower than 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels
   // marked in `unknown` become kUnknown; the depth of the remaining soil pixels is the
-  // soil depth. Sets both outputs of `frame`.
-  void emit(Frame& frame, cv::Mat& residue, const cv::Mat& not_residue, const cv::Mat& unknown,
-            const cv::Mat& depth_mm);
+  // soil depth. Sets both outputs of `frame`. Nothing is allocated in the steady state.
+  void emit(Frame& frame, const cv::Mat& residue, const cv::Mat& not_residue,
+            const cv::Mat& unknown, const cv::Mat& depth_mm);
 
  private:
   const int dilation_px_;
-  const cv::Mat kernel_;
-  const cv::Mat speckle_kernel_;
-  const bool despeckle_;
+  const int speckle_px_;
   MessagePool<ResidueMask> masks_;
   MessagePool<DepthImage> soil_depths_;
 };
