@@ -62,7 +62,8 @@ def convert_to_mcap(folder, mcap):
     with open(graph, "w") as f:
         json.dump({
             "nodes": {
-                "replay": {"type": "recording.image_folder", "params": {"path": folder}},
+                "replay": {"type": "recording.image_folder",
+                           "params": {"path": folder, "host_time": "recorded"}},
                 "record": {"type": "mcap.writer",
                            "params": {"path": mcap, "calibration": CALIBRATION}}},
             "edges": [["replay.raw", "record.raw"], ["replay.color", "record.color"],

@@ -261,9 +261,10 @@ TEST_F(RuntimeTest, EveryStageIsTimed) {
   ASSERT_EQ(result.metrics.stages.size(), 3u);
   EXPECT_EQ(result.metrics.stages[1].node, "d");
   EXPECT_EQ(result.metrics.stages[1].latency.count, 40u);
-  // Delays are uniform in [0, 2) ms: the mean lies well inside.
+  // Delays are uniform in [0, 2) ms, mean 1 ms (the mean of 40 is below 0.5 ms with a
+  // chance of 1e-8). A sleep never ends early, but on a loaded machine it may end much
+  // later, so only the lower bound is a test of the timing.
   EXPECT_GT(result.metrics.stages[1].latency.mean_ms, 0.5);
-  EXPECT_LT(result.metrics.stages[1].latency.mean_ms, 1.8);
   EXPECT_GE(result.metrics.stages[1].latency.p99_ms, result.metrics.stages[1].latency.p50_ms);
   EXPECT_EQ(result.metrics.end_to_end.count, 40u);
   EXPECT_GT(result.metrics.frames_per_second, 0.0);
