@@ -1,8 +1,8 @@
 // The registration's per-row vector loops: projecting a row of depth pixels into the
 // colour camera, and finding the sampler's pixels and the z-buffer cell of each point.
 // row_kernels.cpp is compiled once per x86-64 level (baseline SSE2, v2 = SSE4.2, v3 =
-// AVX2 + FMA, v4 = AVX-512) and row_kernels() picks the best the CPU runs, so the plugin runs on any
-// x86-64 PC yet uses the widest vectors there are; other architectures get their baseline.
+// AVX2 + FMA, v4 = AVX-512) and row_kernels() picks the best the CPU runs, so the plugin runs on
+// any x86-64 PC yet uses the widest vectors there are; other architectures get their baseline.
 #pragma once
 
 #include <array>

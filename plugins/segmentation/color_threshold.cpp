@@ -33,6 +33,7 @@
 
 #include "bit_mask.h"
 #include "color_range_table.h"
+#include "residue_output.h"
 #include "residue_rows.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
@@ -119,68 +120,30 @@ ColorRangeTable residue_colors(const Params& params) {
   return ColorRangeTable(-1, lower, upper);
 }
 
-std::string size_text(const cv::Mat& image) {
-  return std::to_string(image.cols) + "x" + std::to_string(image.rows);
-}
-
-void check_inputs(const RegisteredColor& color, const DepthImage& depth) {
-  if (depth.mm.type() != CV_32FC1) {
-    throw Error("input 'depth': expected a CV_32FC1 image in mm, got type " +
-                std::to_string(depth.mm.type()));
-  }
-  if (color.bgr.type() != CV_8UC3 || color.status.type() != CV_8UC1) {
-    throw Error("input 'color': expected bgr CV_8UC3 and status CV_8UC1, got types " +
-                std::to_string(color.bgr.type()) + " and " + std::to_string(color.status.type()));
-  }
-  if (color.bgr.size() != depth.mm.size() || color.status.size() != depth.mm.size()) {
-    throw Error("input 'color': bgr " + size_text(color.bgr) + " and status " +
-                size_text(color.status) + " do not match the " + size_text(depth.mm) +
-                " depth image (expected colour registered onto the depth grid)");
-  }
-}
-
 // Per-thread working masks: the stage runs frames concurrently, and these keep their
 // buffers from one frame to the next on the same thread.
 struct Scratch {
   BitMask residue;  // trusted colour in the residue range; then despeckled and dilated
   BitMask unknown;  // untrusted colour or no depth
-  BitMask morphology;
   std::vector<std::uint8_t> in_range;  // one row: 255 where the colour is in the range
   std::vector<std::uint8_t> dark;      // one row: 255 where every channel is below min_value
 };
 
 class ColorThreshold final : public Transform {
  public:
-  enum InputPort { kColor = 0, kDepth = 1 };
-  enum OutputPort { kMask = 0, kSoilDepth = 1 };
-
   explicit ColorThreshold(const StageContext& context)
       : residue_colors_(residue_colors(context.params)),
-        dilation_px_(static_cast<int>(context.params.integer("dilation_px"))),
-        speckle_px_(static_cast<int>(context.params.integer("speckle_px"))),
-        min_value_(static_cast<int>(context.params.integer("min_value"))) {}
+        min_value_(static_cast<int>(context.params.integer("min_value"))),
+        output_(context.params) {}
 
   void process(Frame& frame) override {
-    const auto& color = frame.input<RegisteredColor>(kColor);
-    const auto& depth = frame.input<DepthImage>(kDepth);
-    check_inputs(color, depth);
-
-    auto mask = masks_.acquire();
-    auto soil = soil_depths_.acquire();
-    reuse_or_create(mask->values, depth.mm.rows, depth.mm.cols, CV_8UC1);
-    reuse_or_create(soil->mm, depth.mm.rows, depth.mm.cols, CV_32FC1);
-
+    const auto& color = frame.input<RegisteredColor>(kColorInput);
+    const auto& depth = frame.input<DepthImage>(kDepthInput);
+    check_residue_inputs(color, depth);
     thread_local Scratch scratch;
     min_value_ > 0 ? classify<true>(color, depth.mm, scratch)
                    : classify<false>(color, depth.mm, scratch);
-    // An opening (erosion, then dilation by the same square) drops the specks; its
-    // dilation and the edge dilation that follows add up to one square.
-    scratch.residue.erode(speckle_px_, scratch.morphology);
-    scratch.residue.dilate(speckle_px_ + dilation_px_, scratch.morphology);
-    write_outputs(scratch, depth.mm, mask->values, soil->mm);
-
-    frame.set_output(kMask, mask);
-    frame.set_output(kSoilDepth, soil);
+    output_.emit(frame, scratch.residue, scratch.unknown, depth.mm);
   }
 
  private:
@@ -234,20 +197,9 @@ class ColorThreshold final : public Transform {
     }
   }
 
-  static void write_outputs(const Scratch& scratch, const cv::Mat& depth_mm, cv::Mat& mask,
-                            cv::Mat& soil_mm) {
-    for (int y = 0; y < depth_mm.rows; ++y) {
-      write_residue_row(scratch.unknown.row(y), scratch.residue.row(y), depth_mm.ptr<float>(y),
-                        depth_mm.cols, mask.ptr<std::uint8_t>(y), soil_mm.ptr<float>(y));
-    }
-  }
-
   const ColorRangeTable residue_colors_;
-  const int dilation_px_;
-  const int speckle_px_;
   const int min_value_;
-  MessagePool<ResidueMask> masks_;
-  MessagePool<DepthImage> soil_depths_;
+  ResidueOutput output_;
 };
 
 }  // namespace
@@ -256,14 +208,8 @@ StageDescriptor describe_color_threshold() {
   StageDescriptor d;
   d.type = "segmentation.color_threshold";
   d.summary = "residue mask from a colour range, dilated; soil depth = depth outside it";
-  d.inputs = {
-      PortSpec::of<RegisteredColor>("color", "colour on the depth grid, with per-pixel status"),
-      PortSpec::of<DepthImage>("depth", "depth in mm, NaN where none"),
-  };
-  d.outputs = {
-      PortSpec::of<ResidueMask>("mask", "255 residue (dilated), 0 soil, 128 unknown"),
-      PortSpec::of<DepthImage>("soil_depth", "depth where the mask says soil, NaN elsewhere"),
-  };
+  d.inputs = residue_inputs();
+  d.outputs = residue_outputs();
   d.params = {
       ParamSpec::choice("color_space", {"hsv", "lab", "bgr"}, "hsv")
           .describe("colour space of the residue range (OpenCV 8-bit: H 0-180, Lab 0-255)"),
@@ -273,18 +219,9 @@ StageDescriptor describe_color_threshold() {
       ParamSpec::json("residue_upper", nullptr)
           .describe("highest residue colour [c0, c1, c2], inclusive; null = hsv [40, 255, 255], "
                     "lab [255, 132, 255], bgr [255, 255, 255]"),
-      ParamSpec::integer("dilation_px", 2)
-          .range(0, 32)
-          .in_unit("px")
-          .describe("pixels within this distance of residue are residue too; 0 = no dilation"),
-      ParamSpec::integer("speckle_px", 0)
-          .range(0, 8)
-          .in_unit("px")
-          .describe("residue narrower than 2*speckle_px+1 px is dropped before dilation "
-                    "(noise, demosaicing specks); 0 = keep all"),
-      ParamSpec::integer("min_value", 0)
-          .range(0, 255)
-          .describe("pixels whose brightest channel is below this are unknown (deep shadow)"),
+      dilation_px_param(),
+      speckle_px_param(0),
+      min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<ColorThreshold>();

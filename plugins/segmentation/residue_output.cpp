@@ -5,7 +5,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "bit_mask.h"
 #include "residue_rows.h"
 #include "tilth/error.h"
 
@@ -97,15 +96,9 @@ ResidueOutput::ResidueOutput(const Params& params)
 
 void ResidueOutput::emit(Frame& frame, const cv::Mat& residue, const cv::Mat& not_residue,
                          const cv::Mat& unknown, const cv::Mat& depth_mm) {
-  auto mask = masks_.acquire();
-  auto soil = soil_depths_.acquire();
   const int rows = depth_mm.rows;
   const int cols = depth_mm.cols;
-  reuse_or_create(mask->values, rows, cols, CV_8UC1);
-  reuse_or_create(soil->mm, rows, cols, CV_32FC1);
-
-  // As segmentation.color_threshold does it: bit masks, 64 pixels to a word.
-  thread_local BitMask residue_bits, unknown_bits, morphology;
+  thread_local BitMask residue_bits, unknown_bits;
   residue_bits.resize(rows, cols);
   unknown_bits.resize(rows, cols);
   for (int y = 0; y < rows; ++y) {
@@ -119,12 +112,23 @@ void ResidueOutput::emit(Frame& frame, const cv::Mat& residue, const cv::Mat& no
       unknown_row[word] = marked_bits(unknown.ptr<std::uint8_t>(y) + x, count);
     }
   }
+  emit(frame, residue_bits, unknown_bits, depth_mm);
+}
+
+void ResidueOutput::emit(Frame& frame, BitMask& residue, const BitMask& unknown,
+                         const cv::Mat& depth_mm) {
+  auto mask = masks_.acquire();
+  auto soil = soil_depths_.acquire();
+  reuse_or_create(mask->values, depth_mm.rows, depth_mm.cols, CV_8UC1);
+  reuse_or_create(soil->mm, depth_mm.rows, depth_mm.cols, CV_32FC1);
+
   // An opening (erosion, then dilation by the same square) drops the specks; its
   // dilation and the edge dilation that follows add up to one square.
-  residue_bits.erode(speckle_px_, morphology);
-  residue_bits.dilate(speckle_px_ + dilation_px_, morphology);
-  for (int y = 0; y < rows; ++y) {
-    write_residue_row(unknown_bits.row(y), residue_bits.row(y), depth_mm.ptr<float>(y), cols,
+  thread_local BitMask morphology;
+  residue.erode(speckle_px_, morphology);
+  residue.dilate(speckle_px_ + dilation_px_, morphology);
+  for (int y = 0; y < depth_mm.rows; ++y) {
+    write_residue_row(unknown.row(y), residue.row(y), depth_mm.ptr<float>(y), depth_mm.cols,
                       mask->values.ptr<std::uint8_t>(y), soil->mm.ptr<float>(y));
   }
 

@@ -1,7 +1,7 @@
-// What every residue segmentation stage shares with segmentation.color_threshold, so that
-// a graph swaps them by type name: the ports, the input checks, the parameters of the last
-// steps, and those steps from a raw residue decision to the outputs (speck removal,
-// dilation, unknowns, soil depth).
+// What every residue segmentation stage (segmentation.color_threshold and its variants)
+// shares, so that a graph swaps them by type name: the ports, the input checks, the
+// parameters of the last steps, and those steps from a raw residue decision to the
+// outputs (speck removal, dilation, unknowns, soil depth) on bit masks.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +9,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "bit_mask.h"
 #include "tilth/frame.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
@@ -50,11 +51,15 @@ class ResidueOutput {
 
   // `residue` (CV_8UC1, 255/0) is what the variant found. Pixels marked in `not_residue`
   // (if not empty) are taken out of it first, so they cannot grow into their neighbours;
-  // specks narrower than 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels
-  // marked in `unknown` become kUnknown; the depth of the remaining soil pixels is the
-  // soil depth. Sets both outputs of `frame`. Nothing is allocated in the steady state.
+  // then as below. Nothing is allocated in the steady state.
   void emit(Frame& frame, const cv::Mat& residue, const cv::Mat& not_residue,
             const cv::Mat& unknown, const cv::Mat& depth_mm);
+
+  // The same from bit masks (BitMask), `residue` consumed: specks narrower than
+  // 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels marked in `unknown`
+  // become kUnknown; the depth of the remaining soil pixels is the soil depth. Sets both
+  // outputs of `frame`.
+  void emit(Frame& frame, BitMask& residue, const BitMask& unknown, const cv::Mat& depth_mm);
 
  private:
   const int dilation_px_;
