@@ -1,5 +1,6 @@
-// segmentation.color_threshold on a 640x480 frame (the blaze-101's grid) of straw and
-// soil, per colour space and dilation, in ms per frame.
+// The residue segmentations on a 640x480 frame (the blaze-101's grid) of straw and soil,
+// in ms per frame: segmentation.color_threshold per colour space and dilation, and the
+// variants with their defaults (pixel_classifier needs a trained model and is left out).
 #include <memory>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
+#include "variants.h"
 
 namespace tilth::segmentation {
 namespace {
@@ -65,6 +67,25 @@ BENCHMARK_CAPTURE(color_threshold, bgr, "bgr")
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+void variant(benchmark::State& state, StageDescriptor (*describe)()) {
+  testing::TransformHarness stage(describe(), nlohmann::json::object());
+  const auto frame = straw_and_soil_frame();
+  for (auto _ : state) benchmark::DoNotOptimize(stage.run(frame));
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_CAPTURE(variant, color_index, describe_color_index)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(variant, lab_clusters, describe_lab_clusters)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(variant, depth_aided, describe_depth_aided)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(variant, fusion, describe_fusion)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace tilth::segmentation
