@@ -4,11 +4,9 @@
 // (docs/ab-testing.md).
 #include <unistd.h>
 
-#include <csignal>
-#include <cstring>
+#include <cstdio>
 #include <iostream>
 #include <set>
-#include <thread>
 
 #include "comparison.h"
 #include "framework/graph_session.h"
@@ -20,6 +18,7 @@
 #include "progress_bar.h"
 #include "report_html.h"
 #include "report_numbers.h"
+#include "stop_signals.h"
 #include "tilth/log.h"
 
 namespace tilth::ab {
@@ -61,42 +60,6 @@ void print_problems(const Diagnostics& problems) {
   }
   std::cerr << printed.size() << " problem(s); nothing was run\n";
 }
-
-// Waits for SIGINT / SIGTERM on its own thread (blocked everywhere else) and stops the
-// pool; a second signal exits at once.
-class SignalWatcher {
- public:
-  explicit SignalWatcher(JobPool& pool) : pool_(pool), thread_([this] { watch(); }) {}
-  ~SignalWatcher() {
-    done_ = true;
-    thread_.join();
-  }
-
-  static sigset_t stop_signals() {
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
-    return set;
-  }
-
- private:
-  void watch() {
-    const sigset_t set = stop_signals();
-    const timespec tick{0, 100'000'000};
-    int received = 0;
-    while (!done_) {
-      if (sigtimedwait(&set, nullptr, &tick) <= 0) continue;
-      if (++received > 1) std::_Exit(130);
-      log(LogLevel::kWarning, "ab", "stopping: graphs finish their frames in flight");
-      pool_.stop();
-    }
-  }
-
-  JobPool& pool_;
-  std::atomic<bool> done_{false};
-  std::thread thread_;
-};
 
 JobResult job_result(const JobRun& run, const JobFiles& files, const std::string& label,
                      double no_soil_below) {
@@ -211,7 +174,7 @@ int run(Options options) {
   JobPool pool(*registry, options.jobs);
   std::vector<JobRun> runs;
   {
-    SignalWatcher watcher(pool);
+    const tools::StopSignalWatcher watcher("ab", [&pool] { pool.stop(); });
     std::optional<ProgressBar> bar;
     if (!options.quiet && isatty(STDOUT_FILENO) == 1) {
       bar.emplace([&pool] { return pool.progress(); });
@@ -243,9 +206,7 @@ int run(Options options) {
 
 int main(int argc, char** argv) {
   using namespace tilth::ab;
-  // Block the stop signals before any thread exists, so every thread inherits the mask.
-  const sigset_t signals = SignalWatcher::stop_signals();
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  tilth::tools::block_stop_signals();  // before any thread exists
   Options options;
   try {
     options = parse_options(argc, argv);

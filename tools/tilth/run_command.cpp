@@ -1,8 +1,6 @@
 // `tilth run`: runs a graph until its sources end, --frames is reached, or SIGINT /
 // SIGTERM asks it to stop (frames in flight finish, sinks flush, exit code 0).
-#include <csignal>
 #include <iostream>
-#include <thread>
 
 #include <unistd.h>
 
@@ -13,6 +11,7 @@
 #include "framework/runtime.h"
 #include "graph_options.h"
 #include "status_reporter.h"
+#include "stop_signals.h"
 #include "tilth/log.h"
 
 namespace tilth::cli {
@@ -30,55 +29,10 @@ const std::string kUsage =
     "  --quiet                 no status line and no summary\n"
     "  --verbose               debug log lines\n";
 
-// Waits for SIGINT / SIGTERM on its own thread (the signals are blocked everywhere
-// else), so stopping the graph happens outside a signal handler.
-class SignalWatcher {
- public:
-  explicit SignalWatcher(Runtime& runtime) : runtime_(runtime) {
-    thread_ = std::thread([this] { watch(); });
-  }
-  ~SignalWatcher() {
-    done_ = true;
-    thread_.join();
-  }
-
-  static sigset_t stop_signals() {
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
-    return set;
-  }
-
- private:
-  void watch() {
-    const sigset_t set = stop_signals();
-    int received = 0;
-    const timespec tick{0, 100'000'000};
-    while (!done_) {
-      const int signal = sigtimedwait(&set, nullptr, &tick);
-      if (signal <= 0) continue;
-      if (++received > 1) {
-        log(LogLevel::kWarning, "run", "second stop signal: exiting without finishing frames");
-        std::_Exit(130);
-      }
-      log(LogLevel::kInfo, "run",
-          std::string(strsignal(signal)) + ": stopping; frames in flight finish");
-      runtime_.stop();
-    }
-  }
-
-  Runtime& runtime_;
-  std::atomic<bool> done_{false};
-  std::thread thread_;
-};
-
 }  // namespace
 
 int run_command(int argc, char** argv) {
-  // Block the stop signals before any thread exists, so every thread inherits the mask.
-  const sigset_t signals = SignalWatcher::stop_signals();
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  tools::block_stop_signals();  // before any thread exists
 
   const CommandLine line(argc, argv, 2, {"--set", "--var", "--frames"},
                          {"--help", "--quiet", "--verbose"});
@@ -119,7 +73,7 @@ int run_command(int argc, char** argv) {
   log(LogLevel::kInfo, "run", "running " + file);
   RunResult result;
   {
-    SignalWatcher watcher(*runtime);
+    const tools::StopSignalWatcher watcher("run", [&runtime] { runtime->stop(); });
     std::optional<StatusReporter> reporter;
     if (!line.flag("--quiet")) {
       reporter.emplace([&runtime] { return runtime->metrics(); }, isatty(STDERR_FILENO) == 1);
