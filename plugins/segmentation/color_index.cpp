@@ -31,17 +31,11 @@ class ColorIndexStage final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const auto& color = frame.input<RegisteredColor>(kColorInput);
-    const auto& depth = frame.input<DepthImage>(kDepthInput);
-    check_residue_inputs(color, depth);
-
-    thread_local cv::Mat untrusted, unknown, residue;
-    mark_untrusted_color(color, min_value_, untrusted);
-    mark_missing_depth(depth.mm, unknown);
-    cv::bitwise_or(unknown, untrusted, unknown);
-    const IndexSplit split = index_.classify(color.bgr, untrusted, residue);
+    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    thread_local cv::Mat residue;
+    const IndexSplit split = index_.classify(in.color.bgr, in.untrusted, residue);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());
-    output_.emit(frame, residue, untrusted, unknown, depth.mm);
+    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
   }
 
  private:

@@ -39,25 +39,18 @@ class Fusion final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const auto& color = frame.input<RegisteredColor>(kColorInput);
-    const auto& depth = frame.input<DepthImage>(kDepthInput);
-    check_residue_inputs(color, depth);
-
-    thread_local cv::Mat untrusted, missing, unknown, by_color, soil_color, height, by_height;
-    mark_untrusted_color(color, min_value_, untrusted);
-    mark_missing_depth(depth.mm, missing);
-    cv::bitwise_or(untrusted, missing, unknown);
-
-    const IndexSplit split = index_.classify(color.bgr, untrusted, by_color);
+    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    thread_local cv::Mat by_color, soil_color, height, by_height;
+    const IndexSplit split = index_.classify(in.color.bgr, in.untrusted, by_color);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());
-    cv::subtract(by_color, untrusted, by_color);
-    cv::bitwise_or(by_color, unknown, soil_color);
+    cv::subtract(by_color, in.untrusted, by_color);
+    cv::bitwise_or(by_color, in.unknown, soil_color);
     cv::bitwise_not(soil_color, soil_color);
 
-    surface_.heights(depth.mm, missing, soil_color, height);
+    surface_.heights(in.depth.mm, in.missing, soil_color, height);
     cv::compare(height, height_mm_, by_height, cv::CMP_GT);  // NaN: no
     cv::bitwise_or(by_color, by_height, by_color);
-    output_.emit(frame, by_color, cv::Mat(), unknown, depth.mm);
+    output_.emit(frame, by_color, cv::Mat(), in.unknown, in.depth.mm);
   }
 
  private:

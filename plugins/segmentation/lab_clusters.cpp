@@ -143,21 +143,15 @@ class LabClusters final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const auto& color = frame.input<RegisteredColor>(kColorInput);
-    const auto& depth = frame.input<DepthImage>(kDepthInput);
-    check_residue_inputs(color, depth);
-
-    thread_local cv::Mat untrusted, unknown, features, residue;
+    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    thread_local cv::Mat features, residue;
     thread_local std::vector<cv::Vec2f> sample;
-    mark_untrusted_color(color, min_value_, untrusted);
-    mark_missing_depth(depth.mm, unknown);
-    cv::bitwise_or(unknown, untrusted, unknown);
-    chroma_features(color.bgr, smoothing_px_, features);
+    chroma_features(in.color.bgr, smoothing_px_, features);
 
     sample.clear();
     for (int row = 0; row < features.rows; row += kSampleStepPx) {
       const auto* feature = features.ptr<cv::Vec2f>(row);
-      const auto* skip = untrusted.ptr<std::uint8_t>(row);
+      const auto* skip = in.untrusted.ptr<std::uint8_t>(row);
       for (int col = 0; col < features.cols; col += kSampleStepPx) {
         if (skip[col] == 0) sample.push_back(feature[col]);
       }
@@ -177,7 +171,7 @@ class LabClusters final : public Transform {
         out[col] = boundary.residue(feature[col]) ? ResidueMask::kResidue : ResidueMask::kSoil;
       }
     }
-    output_.emit(frame, residue, untrusted, unknown, depth.mm);
+    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
   }
 
  private:

@@ -30,22 +30,16 @@ class PixelClassifier final : public Transform {
         output_(context.params) {}
 
   void process(Frame& frame) override {
-    const auto& color = frame.input<RegisteredColor>(kColorInput);
-    const auto& depth = frame.input<DepthImage>(kDepthInput);
-    check_residue_inputs(color, depth);
-
-    thread_local cv::Mat untrusted, unknown, cells, residue;
-    mark_untrusted_color(color, min_value_, untrusted);
-    mark_missing_depth(depth.mm, unknown);
-    cv::bitwise_or(unknown, untrusted, unknown);
-    color_cells(color.bgr, cells);
+    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    thread_local cv::Mat cells, residue;
+    color_cells(in.color.bgr, cells);
     residue.create(cells.size(), CV_8UC1);
     for (int row = 0; row < cells.rows; ++row) {
       const auto* cell = cells.ptr<std::int32_t>(row);
       auto* out = residue.ptr<std::uint8_t>(row);
       for (int col = 0; col < cells.cols; ++col) out[col] = residue_by_cell_[cell[col]];
     }
-    output_.emit(frame, residue, untrusted, unknown, depth.mm);
+    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
   }
 
  private:

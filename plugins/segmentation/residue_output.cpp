@@ -90,6 +90,17 @@ void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing) {
   cv::bitwise_not(missing, missing);
 }
 
+ResidueInputs read_residue_inputs(const Frame& frame, int min_value) {
+  const auto& color = frame.input<RegisteredColor>(kColorInput);
+  const auto& depth = frame.input<DepthImage>(kDepthInput);
+  check_residue_inputs(color, depth);
+  thread_local cv::Mat untrusted, missing, unknown;
+  mark_untrusted_color(color, min_value, untrusted);
+  mark_missing_depth(depth.mm, missing);
+  cv::bitwise_or(untrusted, missing, unknown);
+  return {color, depth, untrusted, missing, unknown};
+}
+
 ResidueOutput::ResidueOutput(const Params& params)
     : dilation_px_(static_cast<int>(params.integer("dilation_px"))),
       speckle_px_(static_cast<int>(params.integer("speckle_px"))) {}

@@ -42,6 +42,19 @@ void mark_untrusted_color(const RegisteredColor& color, int min_value, cv::Mat& 
 // surface in front of the camera gives.
 void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing);
 
+// A residue segmentation's inputs, checked (check_residue_inputs), and which of their
+// pixels are unknown: `untrusted` colour (mark_untrusted_color), `missing` depth
+// (mark_missing_depth), `unknown` either. The masks belong to the calling thread and
+// hold until its next call.
+struct ResidueInputs {
+  const RegisteredColor& color;
+  const DepthImage& depth;
+  const cv::Mat& untrusted;
+  const cv::Mat& missing;
+  const cv::Mat& unknown;
+};
+ResidueInputs read_residue_inputs(const Frame& frame, int min_value);
+
 class ResidueOutput {
  public:
   enum OutputPort { kMask = 0, kSoilDepth = 1 };
