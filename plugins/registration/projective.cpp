@@ -16,7 +16,7 @@
 // Occlusion is a z-buffer over the colour image, in cells just large enough that a
 // surface seen by both cameras leaves none empty (OcclusionCells): a first pass keeps the
 // nearest point of each cell, and in the second a point more than occlusion_tolerance_mm
-// behind it is occluded. The depth pixels are projected once, in the first pass.
+// behind it is occluded. Each pass projects the depth pixels row by row (see Scratch).
 //
 //   {"type": "registration.projective",
 //    "params": {"calibration": "rig.calib.json", "occlusion_tolerance_mm": 10,
@@ -25,7 +25,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -79,131 +79,122 @@ struct LocatedRow {
   const int* cell;        // CellGrid::outside: not in the colour image
 };
 
-// What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
-// colour camera sees them (located once, read by both passes; their colour pixels only
-// for bilinear sampling, which reads them in the second) and the demosaiced colour image
-// for bilinear sampling of a mosaic.
+// What a frame in flight needs besides its output: the z-buffer, a row of depth pixels
+// as the colour camera sees them, and the demosaiced colour image for bilinear sampling
+// of a mosaic. Each pass locates the rows anew: that costs less than the memory traffic
+// of keeping every row's locations from the first pass to the second.
 struct Scratch {
-  std::vector<float> nearest_mm;        // per cell: the nearest depth along the colour axis
-  std::vector<float> color_u, color_v;  // a row, or every row for bilinear sampling
-  std::vector<float> color_depth;       // every row, of DepthToColor::row_capacity()
+  // An empty cell's depth: the float whose bytes are all kFarByte, 3.4e38 mm, farther
+  // than any point.
+  static constexpr int kFarByte = 0x7f;
+
+  std::vector<float> nearest_mm;  // per cell: the nearest depth along the colour axis
+  std::vector<float> color_u, color_v, color_depth;
   std::vector<int> key, cell;
   cv::Mat demosaiced;  // CV_8UC3
 
-  void prepare(const DepthToColor& map, const OcclusionCells& cells, bool bilinear) {
+  void prepare(const DepthToColor& map, const OcclusionCells& cells) {
     const auto row = static_cast<std::size_t>(map.row_capacity());
-    const auto frame = row * static_cast<std::size_t>(map.depth_height());
-    for (auto* values : {&color_u, &color_v}) values->resize(bilinear ? frame : row);
-    color_depth.resize(frame);
-    for (auto* values : {&key, &cell}) values->resize(frame);
-    nearest_mm.assign(static_cast<std::size_t>(cells.grid().outside) + 1,
-                      std::numeric_limits<float>::infinity());
-  }
-
-  LocatedRow row(const DepthToColor& map, int v) const {
-    const std::size_t start = start_of(map, v);
-    const std::size_t uv = uv_start_of(start);
-    return {color_u.data() + uv, color_v.data() + uv, color_depth.data() + start,
-            key.data() + start, cell.data() + start};
+    for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(row);
+    for (auto* values : {&key, &cell}) values->resize(row);
+    // Cleared to kFar with memset, the fastest way to clear it.
+    nearest_mm.resize(static_cast<std::size_t>(cells.grid().count()));
+    std::memset(nearest_mm.data(), kFarByte, nearest_mm.size() * sizeof(float));
   }
 
   // Projects depth row `v` and finds each point's pixels for the sampler and its cell.
   LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
                     int v, const Addressing& addressing) {
-    const std::size_t start = start_of(map, v);
-    const std::size_t uv = uv_start_of(start);
-    map.project_row(v, depth.ptr<float>(v), color_u.data() + uv, color_v.data() + uv,
-                    color_depth.data() + start);
+    map.project_row(v, depth.ptr<float>(v), color_u.data(), color_v.data(), color_depth.data());
     map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
-                         map.row_capacity(), color_u.data() + uv, color_v.data() + uv,
-                         color_depth.data() + start, key.data() + start, cell.data() + start);
-    return row(map, v);
+                         map.row_capacity(), color_u.data(), color_v.data(), color_depth.data(),
+                         key.data(), cell.data());
+    return {color_u.data(), color_v.data(), color_depth.data(), key.data(), cell.data()};
   }
-
- private:
-  static std::size_t start_of(const DepthToColor& map, int v) {
-    return static_cast<std::size_t>(v) * static_cast<std::size_t>(map.row_capacity());
-  }
-  std::size_t uv_start_of(std::size_t start) const { return color_u.size() > start ? start : 0; }
 };
 
-template <bool kBilinear, class Sampler>
-Bgr sample(const Sampler& sampler, const LocatedRow& row, int i, int width, int height) {
-  if constexpr (!kBilinear) {
-    return sampler.at(row.key[i]);
-  } else {
-    const float u = row.u[i];
-    const float v = row.v[i];
-    // u, v >= -0.5: truncation of u + 1 is floor(u) + 1. Weights in 1/256.
-    const int x0 = static_cast<int>(u + 1.0f) - 1;
-    const int y0 = static_cast<int>(v + 1.0f) - 1;
-    const int wx = static_cast<int>((u - static_cast<float>(x0)) * 256.0f + 0.5f);
-    const int wy = static_cast<int>((v - static_cast<float>(y0)) * 256.0f + 0.5f);
-    // The neighbours, clamped to the image.
-    const std::ptrdiff_t top_left = sampler.offset(std::max(x0, 0), std::max(y0, 0));
-    const std::ptrdiff_t right = x0 >= 0 && x0 + 1 < width ? Sampler::kPixelBytes : 0;
-    const std::ptrdiff_t down = y0 >= 0 && y0 + 1 < height ? sampler.step() : 0;
-    const Bgr a = sampler.at(top_left);
-    const Bgr b = sampler.at(top_left + right);
-    const Bgr c = sampler.at(top_left + down);
-    const Bgr d = sampler.at(top_left + down + right);
-    const auto blend = [&](int ca, int cb, int cc, int cd) {
-      const int upper = ca * (256 - wx) + cb * wx;
-      const int lower = cc * (256 - wx) + cd * wx;
-      return (upper * (256 - wy) + lower * wy + (1 << 15)) >> 16;
-    };
-    return {blend(a.b, b.b, c.b, d.b), blend(a.g, b.g, c.g, d.g), blend(a.r, b.r, c.r, d.r)};
+// The first pass: the nearest point of each cell.
+void fill_z_buffer(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                   const Addressing& addressing, Scratch& scratch) {
+  scratch.prepare(map, cells);
+  for (int v = 0; v < map.depth_height(); ++v) {
+    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing);
+    map.kernels().keep_nearest(cells.grid(), map.row_capacity(), row.depth_mm, row.cell,
+                               scratch.nearest_mm.data());
   }
 }
 
-template <bool kBilinear, class Sampler>
-void register_frame(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                    const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
-                    RegisteredColor& out) {
-  scratch.prepare(map, cells, kBilinear);
+Visibility visibility(const Scratch& scratch, const OcclusionCells& cells, float tolerance_mm) {
+  return {scratch.nearest_mm.data(), cells.grid().outside,      tolerance_mm,
+          RegisteredColor::kValid,   RegisteredColor::kNoDepth, RegisteredColor::kOutsideColor,
+          RegisteredColor::kOccluded};
+}
+
+void register_nearest(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                      const NearestPixels& pixels, float occlusion_tolerance_mm, Scratch& scratch,
+                      RegisteredColor& out) {
+  fill_z_buffer(map, cells, depth, pixels.addressing, scratch);
+  const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
+  for (int v = 0; v < map.depth_height(); ++v) {
+    const LocatedRow row = scratch.locate(map, cells, depth, v, pixels.addressing);
+    map.kernels().resolve(seen, pixels.word, map.depth_width(), depth.ptr<float>(v), row.depth_mm,
+                          row.cell, row.key, out.status.ptr<std::uint8_t>(v),
+                          out.bgr.ptr<std::uint8_t>(v));
+  }
+}
+
+// The four pixels around (u, v), blended; u, v >= -0.5.
+template <class Sampler>
+Bgr bilinear_sample(const Sampler& sampler, float u, float v, int width, int height) {
+  // Truncation of u + 1 is floor(u) + 1. Weights in 1/256.
+  const int x0 = static_cast<int>(u + 1.0f) - 1;
+  const int y0 = static_cast<int>(v + 1.0f) - 1;
+  const int wx = static_cast<int>((u - static_cast<float>(x0)) * 256.0f + 0.5f);
+  const int wy = static_cast<int>((v - static_cast<float>(y0)) * 256.0f + 0.5f);
+  // The neighbours, clamped to the image.
+  const std::ptrdiff_t top_left = sampler.offset(std::max(x0, 0), std::max(y0, 0));
+  const std::ptrdiff_t right = x0 >= 0 && x0 + 1 < width ? Sampler::kPixelBytes : 0;
+  const std::ptrdiff_t down = y0 >= 0 && y0 + 1 < height ? sampler.step() : 0;
+  const Bgr a = sampler.at(top_left);
+  const Bgr b = sampler.at(top_left + right);
+  const Bgr c = sampler.at(top_left + down);
+  const Bgr d = sampler.at(top_left + down + right);
+  const auto blend = [&](int ca, int cb, int cc, int cd) {
+    const int upper = ca * (256 - wx) + cb * wx;
+    const int lower = cc * (256 - wx) + cd * wx;
+    return (upper * (256 - wy) + lower * wy + (1 << 15)) >> 16;
+  };
+  return {blend(a.b, b.b, c.b, d.b), blend(a.g, b.g, c.g, d.g), blend(a.r, b.r, c.r, d.r)};
+}
+
+template <class Sampler>
+void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
+                       const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
+                       RegisteredColor& out) {
   const Sampler colors = sampler;  // a local: see LocatedRow
-  const Addressing addressing = colors.addressing();
-  float* const nearest_mm = scratch.nearest_mm.data();
+  fill_z_buffer(map, cells, depth, colors.addressing(), scratch);
+  const float* const nearest_mm = scratch.nearest_mm.data();
   const int outside = cells.grid().outside;
-  const int width = map.depth_width();
-  const int height = map.depth_height();
   const int color_width = map.color_width();
   const int color_height = map.color_height();
-
-  // The nearest point of each cell. Points not shown have NaN depth, which std::min
-  // ignores: the outside cell stays at infinity.
-  for (int v = 0; v < height; ++v) {
-    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing);
-    for (int u = 0; u < width; ++u) {
-      float& nearest = nearest_mm[row.cell[u]];
-      nearest = std::min(nearest, row.depth_mm[u]);
-    }
-  }
-
-  // Without branches on the status, which changes unpredictably at straw edges: a NaN
-  // depth is never visible, and nearest sampling may read the pixel of any key.
-  for (int v = 0; v < height; ++v) {
-    const LocatedRow row = scratch.row(map, v);
+  for (int v = 0; v < map.depth_height(); ++v) {
+    const LocatedRow row = scratch.locate(map, cells, depth, v, colors.addressing());
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);
-    for (int u = 0; u < width; ++u) {
+    for (int u = 0; u < map.depth_width(); ++u) {
       const int cell = row.cell[u];
       const bool visible = row.depth_mm[u] <= nearest_mm[cell] + occlusion_tolerance_mm;
       status[u] = visible            ? RegisteredColor::kValid
                   : cell != outside  ? RegisteredColor::kOccluded
                   : std::isnan(z[u]) ? RegisteredColor::kNoDepth
                                      : RegisteredColor::kOutsideColor;
-      Bgr color{0, 0, 0};
-      if constexpr (kBilinear) {
-        if (visible) color = sample<true>(colors, row, u, color_width, color_height);
-      } else {
-        color = sample<false>(colors, row, u, color_width, color_height);
-      }
-      const int keep = visible ? 0xff : 0;
-      bgr[3 * u] = static_cast<std::uint8_t>(color.b & keep);
-      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g & keep);
-      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r & keep);
+      const Bgr color = visible
+                            ? bilinear_sample(colors, row.u[u], row.v[u], color_width, color_height)
+                            : Bgr{0, 0, 0};
+      bgr[3 * u] = static_cast<std::uint8_t>(color.b);
+      bgr[3 * u + 1] = static_cast<std::uint8_t>(color.g);
+      bgr[3 * u + 2] = static_cast<std::uint8_t>(color.r);
     }
   }
 }
@@ -222,49 +213,11 @@ class ProjectiveRegistration final : public Transform {
     reuse_or_create(out->bgr, map_.depth_height(), map_.depth_width(), CV_8UC3);
     reuse_or_create(out->status, map_.depth_height(), map_.depth_width(), CV_8UC1);
     const auto scratch = scratch_.acquire();
-    const auto run = [&](const auto& sampler) {
-      if (bilinear_) {
-        register_frame<true>(map_, cells_, depth, sampler, occlusion_tolerance_mm_, *scratch, *out);
-      } else {
-        register_frame<false>(map_, cells_, depth, sampler, occlusion_tolerance_mm_, *scratch,
-                              *out);
-      }
-    };
-    // Nearest sampling reads a mosaic at the quad nearest each point; bilinear sampling
-    // blends demosaiced pixels. OpenCV names a mosaic by its second row's second and
-    // third pixels, one pixel off the usual naming by the top-left 2x2 tile.
-    const auto run_mosaic = [&](std::string_view tile, int opencv_code) {
-      if (bilinear_) {
-        cv::cvtColor(color.pixels, scratch->demosaiced, opencv_code);
-        register_frame<true>(map_, cells_, depth, BgrSampler(scratch->demosaiced),
-                             occlusion_tolerance_mm_, *scratch, *out);
-      } else {
-        register_frame<false>(map_, cells_, depth, BayerQuadSampler(color.pixels, tile),
-                              occlusion_tolerance_mm_, *scratch, *out);
-      }
-    };
-    switch (color.format) {
-      case PixelFormat::kBgr8:
-        run(BgrSampler(color.pixels));
-        break;
-      case PixelFormat::kRgb8:
-        run(RgbSampler(color.pixels));
-        break;
-      case PixelFormat::kMono8:
-        run(MonoSampler(color.pixels));
-        break;
-      case PixelFormat::kBayerRggb8:
-        run_mosaic("RGGB", cv::COLOR_BayerBG2BGR);
-        break;
-      case PixelFormat::kBayerBggr8:
-        run_mosaic("BGGR", cv::COLOR_BayerRG2BGR);
-        break;
-      case PixelFormat::kBayerGrbg8:
-        run_mosaic("GRBG", cv::COLOR_BayerGB2BGR);
-        break;
-      case PixelFormat::kBayerGbrg8:
-        run_mosaic("GBRG", cv::COLOR_BayerGR2BGR);
-        break;
+    if (bilinear_) {
+      register_bilinear(depth, color, *scratch, *out);
+    } else {
+      register_nearest(map_, cells_, depth, nearest_pixels(color.pixels, color.format),
+                       occlusion_tolerance_mm_, *scratch, *out);
     }
     frame.set_output(0, std::move(out));
   }
@@ -280,6 +233,36 @@ class ProjectiveRegistration final : public Transform {
         occlusion_tolerance_mm_(
             static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
         bilinear_(context.params.string("interpolation") == "bilinear") {}
+
+  // Bilinear sampling blends demosaiced pixels. OpenCV names a mosaic by its second
+  // row's second and third pixels, one pixel off the usual naming by the top-left tile.
+  void register_bilinear(const cv::Mat& depth, const ColorImage& color, Scratch& scratch,
+                         RegisteredColor& out) const {
+    const auto run = [&](const auto& sampler) {
+      registration::register_bilinear(map_, cells_, depth, sampler, occlusion_tolerance_mm_,
+                                      scratch, out);
+    };
+    const auto demosaiced = [&](int opencv_code) {
+      cv::cvtColor(color.pixels, scratch.demosaiced, opencv_code);
+      return BgrSampler(scratch.demosaiced);
+    };
+    switch (color.format) {
+      case PixelFormat::kBgr8:
+        return run(BgrSampler(color.pixels));
+      case PixelFormat::kRgb8:
+        return run(RgbSampler(color.pixels));
+      case PixelFormat::kMono8:
+        return run(MonoSampler(color.pixels));
+      case PixelFormat::kBayerRggb8:
+        return run(demosaiced(cv::COLOR_BayerBG2BGR));
+      case PixelFormat::kBayerBggr8:
+        return run(demosaiced(cv::COLOR_BayerRG2BGR));
+      case PixelFormat::kBayerGrbg8:
+        return run(demosaiced(cv::COLOR_BayerGB2BGR));
+      case PixelFormat::kBayerGbrg8:
+        return run(demosaiced(cv::COLOR_BayerGR2BGR));
+    }
+  }
 
   void check(const cv::Mat& depth, const ColorImage& color) const {
     if (depth.type() != CV_32FC1) {

@@ -6,6 +6,11 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 #include "lens_model.h"
 #include "row_kernels.h"
@@ -30,13 +35,59 @@ static_assert(kRowLanes % kLanes == 0, "rows are whole vectors of every level");
 
 using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
 using Ints = std::int32_t __attribute__((vector_size(kLanes * sizeof(std::int32_t))));
+using Words = std::uint32_t __attribute__((vector_size(kLanes * sizeof(std::uint32_t))));
+using Bytes = std::uint8_t __attribute__((vector_size(kLanes)));
+using WordBytes = std::uint8_t __attribute__((vector_size(kLanes * sizeof(std::uint32_t))));
 
 // Vectors go by reference: returned by value they would be passed differently per level.
 void load(Floats& v, const float* values) { std::memcpy(&v, values, sizeof v); }
+void load(Ints& v, const int* values) { std::memcpy(&v, values, sizeof v); }
 void store(float* values, const Floats& v) { std::memcpy(values, &v, sizeof v); }
 void store(int* values, const Ints& v) { std::memcpy(values, &v, sizeof v); }
 
 Floats splat(float value) { return Floats{} + value; }
+
+// Lane i of a vector as an index vector built from i: the masks of __builtin_shuffle.
+template <class Vector, class Lane, std::size_t... kLane>
+constexpr Vector lanes_of(Lane lane, std::index_sequence<kLane...>) {
+  return Vector{lane(static_cast<int>(kLane))...};
+}
+template <class Vector, int kCount = kLanes, class Lane>
+constexpr Vector lanes_of(Lane lane) {
+  return lanes_of<Vector>(lane, std::make_index_sequence<kCount>());
+}
+
+// base[index] for each lane; the 32-bit words at base + offset. (The masked gathers,
+// from zeros: GCC 12's unmasked ones start from an undefined vector and warn.)
+[[gnu::always_inline]] inline void gather(Floats& values, const float* base, const Ints& index) {
+#if defined(__AVX512F__)
+  values = reinterpret_cast<Floats>(_mm512_mask_i32gather_ps(
+      _mm512_setzero_ps(), 0xffff, reinterpret_cast<__m512i>(index), base, 4));
+#elif defined(__AVX2__)
+  const __m256 all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  values = reinterpret_cast<Floats>(_mm256_mask_i32gather_ps(
+      _mm256_setzero_ps(), base, reinterpret_cast<__m256i>(index), all, 4));
+#else
+  for (int lane = 0; lane < kLanes; ++lane) values[lane] = base[index[lane]];
+#endif
+}
+[[gnu::always_inline]] inline void gather_words(Words& words, const std::uint8_t* base,
+                                                const Ints& offset) {
+#if defined(__AVX512F__)
+  words = reinterpret_cast<Words>(_mm512_mask_i32gather_epi32(
+      _mm512_setzero_si512(), 0xffff, reinterpret_cast<__m512i>(offset), base, 1));
+#elif defined(__AVX2__)
+  words = reinterpret_cast<Words>(
+      _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(base),
+                                  reinterpret_cast<__m256i>(offset), _mm256_set1_epi32(-1), 1));
+#else
+  for (int lane = 0; lane < kLanes; ++lane) {
+    std::uint32_t word;
+    std::memcpy(&word, base + offset[lane], sizeof word);
+    words[lane] = word;
+  }
+#endif
+}
 
 // The model's numbers as vectors, held in registers: loop stores through float pointers
 // could alias the model, so its fields would be loaded again for every vector.
@@ -114,6 +165,148 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
   ys == nullptr ? run.template operator()<true>() : run.template operator()<false>();
 }
 
+// The nearest point of each cell: nearest_mm[cell] = min(nearest_mm[cell], depth) for
+// each point. Neighbouring points mostly share a cell, and a store followed by a load of
+// the same cell waits for the store. So each run of lanes with one cell first takes its
+// minimum in the vector (the lanes before each lane, 1, 2, 4, ... back, that share its
+// cell), and its last lane alone writes the cell. The writes are listed in `written` and
+// `mins` (room for kLanes) and applied a chunk later, because a load of a lane just
+// stored from a vector would wait for the store. With AVX-512 the list holds the writes
+// alone; otherwise the lanes that do not write list spare cells of their own. Returns
+// the length of the list.
+[[gnu::always_inline]] inline int run_minimums(const Ints& cell, const Floats& depth,
+                                               const Ints& outside,
+                                               [[maybe_unused]] const Ints& spares, int* written,
+                                               float* mins) {
+  Floats run_min = depth;
+  const auto step_back = [&]<int kStep>() {
+    constexpr Ints kBack =
+        lanes_of<Ints>([](int lane) { return lane >= kStep ? lane - kStep : lane; });
+    const Ints earlier_cell = __builtin_shuffle(cell, kBack);
+    const Floats earlier_min = __builtin_shuffle(run_min, kBack);
+    run_min = (earlier_cell == cell) & (earlier_min < run_min) ? earlier_min : run_min;
+  };
+  step_back.template operator()<1>();
+  step_back.template operator()<2>();
+  if constexpr (kLanes > 4) step_back.template operator()<4>();
+  if constexpr (kLanes > 8) step_back.template operator()<8>();
+  constexpr Ints kNext =
+      lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? lane + 1 : lane; });
+  constexpr Ints kLast = lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? 0 : -1; });
+  // The outside cell's points have NaN depth: no write changes it.
+  const Ints writes = ((__builtin_shuffle(cell, kNext) != cell) | kLast) & (cell != outside);
+#if defined(__AVX512F__)
+  const __mmask16 lanes = _mm512_movepi32_mask(reinterpret_cast<__m512i>(writes));
+  _mm512_storeu_si512(written, _mm512_maskz_compress_epi32(lanes, reinterpret_cast<__m512i>(cell)));
+  _mm512_storeu_ps(mins, _mm512_maskz_compress_ps(lanes, reinterpret_cast<__m512>(run_min)));
+  return __builtin_popcount(lanes);
+#else
+  store(written, writes ? cell : spares);
+  store(mins, run_min);
+  return kLanes;
+#endif
+}
+
+// The 4 bytes at base + offset for each lane, never reading past base + last + 3: a word
+// is read from at most `last` and shifted down to the bytes wanted. Offsets are >= 0.
+[[gnu::always_inline]] inline void read_words(Words& words, const std::uint8_t* base,
+                                              const Ints& offset, const Ints& last) {
+  const Ints start = offset < last ? offset : last;
+  gather_words(words, base, start);
+  words >>= reinterpret_cast<Words>((offset - start) << 3);
+}
+
+// The colour of each lane's key as blue | green << 8 | red << 16.
+template <bool kQuad>
+[[gnu::always_inline]] inline void read_colors(Words& colors, const PixelWord& pixels,
+                                               const Ints& key) {
+  const Ints offset = key >> pixels.key_shift;
+  const Ints last = Ints{} + static_cast<int>(pixels.size - 4);
+  Words word;
+  read_words(word, pixels.data, offset, last);
+  if constexpr (kQuad) {
+    Words second;
+    read_words(second, pixels.data, offset + static_cast<int>(pixels.second_row), last);
+    word = (word & 0xffffu) | (second << 16);
+  }
+  const Words phase = reinterpret_cast<Words>(key & pixels.phase_mask);
+  const auto channel = [&](int site) {
+    return (word >> ((phase ^ static_cast<std::uint32_t>(site)) << 3)) & 0xffu;
+  };
+  const Words green = (channel(pixels.sites[1]) + channel(pixels.sites[2]) + 1) >> 1;
+  colors = channel(pixels.sites[0]) | (green << 8) | (channel(pixels.sites[3]) << 16);
+}
+
+// Each lane's blue, green and red bytes, packed: the 3 low bytes of each word within each
+// 16-byte block, then the blocks' 12 bytes together; `bytes` of them written.
+[[gnu::always_inline]] inline void pack_bgr(std::uint8_t* bgr, const Words& colors, int bytes) {
+  constexpr WordBytes kInBlocks = lanes_of<WordBytes, 4 * kLanes>([](int byte) {
+    const int block = byte / 16, in_block = byte % 16;
+    return in_block < 12 ? block * 16 + in_block / 3 * 4 + in_block % 3 : byte;
+  });
+  constexpr Ints kBlocksTogether = lanes_of<Ints>(
+      [](int word) { return word < kLanes / 4 * 3 ? word / 3 * 4 + word % 3 : word; });
+  const WordBytes in_blocks = __builtin_shuffle(reinterpret_cast<WordBytes>(colors), kInBlocks);
+  const Ints packed = __builtin_shuffle(reinterpret_cast<Ints>(in_blocks), kBlocksTogether);
+  std::memcpy(bgr, &packed, static_cast<std::size_t>(bytes));
+}
+
+template <bool kQuad>
+void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int count,
+                     const float* z_mm, const float* color_depth, const int* cell_indices,
+                     const int* keys, std::uint8_t* status, std::uint8_t* bgr) {
+  const Ints zeros{};
+  const Floats tolerance = splat(visibility.tolerance_mm);
+  const Ints outside = zeros + visibility.outside;
+  const Ints valid = zeros + visibility.valid, no_depth = zeros + visibility.no_depth;
+  const Ints outside_color = zeros + visibility.outside_color;
+  const Ints occluded = zeros + visibility.occluded;
+  // `lanes` pixels from i on, writing `bgr_bytes` of colour.
+  const auto resolve_lanes = [&](int i, int lanes, int bgr_bytes) __attribute__((always_inline)) {
+    Floats z;
+    if (lanes == kLanes) {
+      load(z, z_mm + i);
+    } else {  // the row's last, partial vector: no reading past its end
+      float tail[kLanes] = {};
+      std::memcpy(tail, z_mm + i, static_cast<std::size_t>(lanes) * sizeof(float));
+      load(z, tail);
+    }
+    Floats depth, nearest;
+    Ints cell, key;
+    load(depth, color_depth + i);
+    load(cell, cell_indices + i);
+    load(key, keys + i);
+    gather(nearest, visibility.nearest_mm, cell);
+    const Ints visible = depth <= nearest + tolerance;  // NaN compares false
+    const Ints code = visible           ? valid
+                      : cell != outside ? occluded
+                      : z != z          ? no_depth
+                                        : outside_color;
+    const Bytes codes = __builtin_convertvector(code, Bytes);
+    std::memcpy(status + i, &codes, static_cast<std::size_t>(lanes));
+    Words colors;
+    read_colors<kQuad>(colors, pixels, key);
+    pack_bgr(bgr + 3 * i, colors & reinterpret_cast<Words>(visible), bgr_bytes);
+  };
+  // While a whole vector follows, a vector's colours are written as whole words: their
+  // last kLanes bytes are junk that the next vector overwrites.
+  int i = 0;
+  for (; i + 2 * kLanes <= count; i += kLanes) resolve_lanes(i, kLanes, 4 * kLanes);
+  for (; i < count; i += kLanes) {
+    const int lanes = count - i < kLanes ? count - i : kLanes;
+    resolve_lanes(i, lanes, 3 * lanes);
+  }
+}
+
+void resolve(const Visibility& visibility, const PixelWord& pixels, int count, const float* z_mm,
+             const float* color_depth, const int* cell_indices, const int* keys,
+             std::uint8_t* status, std::uint8_t* bgr) {
+  pixels.second_row != 0 ? resolve_vectors<true>(visibility, pixels, count, z_mm, color_depth,
+                                                 cell_indices, keys, status, bgr)
+                         : resolve_vectors<false>(visibility, pixels, count, z_mm, color_depth,
+                                                  cell_indices, keys, status, bgr);
+}
+
 // The sampler's top-left pixel x = floor(u + (1 - span) / 2 + 0.5) = trunc(u + 2 -
 // span / 2) - 1, clamped in float (NaN clamps too), where the truncation is a floor.
 void locate(const Addressing& addressing, const CellGrid& cells, int color_width, int color_height,
@@ -149,8 +342,34 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
   }
 }
 
+void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
+                  const int* cell_indices, float* nearest_mm) {
+  const Ints outside = Ints{} + cells.outside;
+  const Ints spares = lanes_of<Ints>([&](int lane) { return cells.outside + 1 + lane; });
+  constexpr int kChunk = 256;
+  static_assert(kChunk % kRowLanes == 0);
+  int written[kChunk + kLanes];
+  float mins[kChunk + kLanes];
+  for (int chunk = 0; chunk < count; chunk += kChunk) {
+    const int end = count - chunk < kChunk ? count : chunk + kChunk;
+    int listed = 0;
+    for (int i = chunk; i < end; i += kLanes) {
+      Floats depth;
+      Ints cell;
+      load(depth, color_depth + i);
+      load(cell, cell_indices + i);
+      listed += run_minimums(cell, depth, outside, spares, written + listed, mins + listed);
+    }
+    for (int i = 0; i < listed; ++i) {
+      float& nearest = nearest_mm[written[i]];
+      nearest = mins[i] < nearest ? mins[i] : nearest;
+    }
+  }
+}
+
 }  // namespace
 
-extern const RowKernels kRowKernels{project, locate, TILTH_KERNEL_LEVEL_NAME};
+extern const RowKernels kRowKernels{project, locate, keep_nearest, resolve,
+                                    TILTH_KERNEL_LEVEL_NAME};
 
 }  // namespace tilth::registration::TILTH_KERNEL_LEVEL

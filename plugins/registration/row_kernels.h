@@ -1,17 +1,20 @@
 // The registration's per-row vector loops: projecting a row of depth pixels into the
-// colour camera, and finding the sampler's pixels and the z-buffer cell of each point.
+// colour camera; finding each point's colour pixels and z-buffer cell and keeping the
+// nearest point of each cell; and, once every row is in the z-buffer, each point's status
+// and nearest-sampled colour.
 // row_kernels.cpp is compiled once per x86-64 level (baseline SSE2, v2 = SSE4.2, v3 =
 // AVX2 + FMA, v4 = AVX-512) and row_kernels() picks the best the CPU runs, so the plugin runs on
 // any x86-64 PC yet uses the widest vectors there are; other architectures get their baseline.
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "color_sampler.h"
+#include "pixel_word.h"
 
 namespace tilth::registration {
 
@@ -35,12 +38,25 @@ struct ProjectionModel {
   float edge_margin_px;
 };
 
-// The z-buffer's cells: squares of `size` colour pixels, `columns` to a row, and one
-// more cell, `outside`, for the points the colour image does not show.
+// The z-buffer's cells: squares of `size` colour pixels, `columns` to a row; one more
+// cell, `outside`, for the points the colour image does not show; and after it
+// kSpareCells that the kernels write to instead of a cell where that saves a wait.
 struct CellGrid {
+  static constexpr int kSpareCells = kRowLanes;
+
   int size;
   int columns;
   int outside;
+
+  int count() const { return outside + 1 + kSpareCells; }
+};
+
+// What decides a located point's status, and the status codes (RegisteredColor's).
+struct Visibility {
+  const float* nearest_mm;  // the z-buffer, per cell
+  int outside;              // CellGrid::outside
+  float tolerance_mm;       // occlusion_tolerance_mm
+  std::uint8_t valid, no_depth, outside_color, occluded;
 };
 
 struct RowKernels {
@@ -50,11 +66,24 @@ struct RowKernels {
   // the colour image does not show the point.
   void (*project)(const ProjectionModel& model, const float* x, const float* y, float row_y,
                   const float* z_mm, float* color_u, float* color_v, float* color_depth);
-  // For `count` projected points: the sampler's pixel key (Addressing; clamped to the
-  // image, so that a point not shown reads a pixel too) and the cell.
+  // For `count` projected points (a multiple of kRowLanes): the key of the pixels
+  // nearest sampling reads (Addressing; clamped to the image, so that a point not shown
+  // reads pixels too) and the cell.
   void (*locate)(const Addressing& addressing, const CellGrid& cells, int color_width,
                  int color_height, int count, const float* color_u, const float* color_v,
                  const float* color_depth, int* keys, int* cell_indices);
+  // nearest_mm (CellGrid::count() floats) lowered to the depth of each of `count`
+  // located points (a multiple of kRowLanes) in its cell. Points not shown have NaN
+  // depth, which leaves the outside cell as it was.
+  void (*keep_nearest)(const CellGrid& cells, int count, const float* color_depth,
+                       const int* cell_indices, float* nearest_mm);
+  // For `count` located points of a depth row at z_mm: status (Visibility) and, where
+  // valid, the colour at the key's pixels (blue, green, red; the mean of a quad's
+  // greens), else black. Reads whole vectors of the located arrays; writes `count`
+  // statuses and 3 * `count` bytes.
+  void (*resolve)(const Visibility& visibility, const PixelWord& pixels, int count,
+                  const float* z_mm, const float* color_depth, const int* cell_indices,
+                  const int* keys, std::uint8_t* status, std::uint8_t* bgr);
   const char* level;  // "x86-64-v4", ...
 };
 

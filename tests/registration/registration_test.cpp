@@ -294,6 +294,32 @@ TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProj
   }
 }
 
+TEST(ProjectiveRegistration, ImagesOfNoWholeVectorsMatchTheReferenceToTheirLastPixel) {
+  // A depth row of 613 pixels ends in a partial vector at every level, and a colour image
+  // of 1279 x 1021 pixels has odd rows and ends on a byte that no whole word after it
+  // covers: the last partial vector and the last colour pixels are read and written
+  // exactly, and nothing beyond them is. With the colour camera on the left, the ToF
+  // image's right edge is in its view.
+  json document = paper_rig();
+  document["depth_to_color"]["T_mm"] = {-45.0, 0.0, 0.0};
+  document["depth_camera"]["width"] = 613;
+  document["color_camera"]["width"] = 1279;
+  document["color_camera"]["height"] = 1021;
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  for (const std::string& level : levels()) {
+    SCOPED_TRACE(level);
+    const auto out = register_color(*make_registration(file.path(), "nearest", 10.0, level), depth,
+                                    coordinate_image(1279, 1021));
+    const Agreement a = compare(document, file.path(), depth, rays, *out, level);
+    expect_agreement(a, 230000);
+    // The last column is seen and sampled like the others.
+    EXPECT_GT(cv::countNonZero(out->status.col(612) == RegisteredColor::kValid), 400);
+  }
+}
+
 TEST(ProjectiveRegistration, AnInstructionSetTheCpuDoesNotRunIsRefused) {
   std::string runnable;
   for (const std::string& level : levels()) runnable += (runnable.empty() ? "" : ", ") + level;
@@ -512,6 +538,14 @@ cv::Mat mosaic(const cv::Mat& bgr, PixelFormat format) {
 constexpr PixelFormat kBayerFormats[] = {PixelFormat::kBayerRggb8, PixelFormat::kBayerBggr8,
                                          PixelFormat::kBayerGrbg8, PixelFormat::kBayerGbrg8};
 
+std::vector<std::pair<PixelFormat, std::string>> every_pattern_at_every_level() {
+  std::vector<std::pair<PixelFormat, std::string>> cases;
+  for (const PixelFormat format : kBayerFormats) {
+    for (const std::string& level : levels()) cases.emplace_back(format, level);
+  }
+  return cases;
+}
+
 TEST(ProjectiveRegistration, EachBayerPatternGivesBackAKnownColour) {
   // Demosaicing a uniform mosaic gives its colour back exactly, and only with the right
   // pattern: one swapped diagonal turns (30, 120, 210) into (210, 120, 30), one pixel of
@@ -534,10 +568,11 @@ TEST(ProjectiveRegistration, NearestSamplingOfAMosaicReadsTheQuadNearestThePoint
   // Every 2x2 quad of a mosaic holds one red, one blue and two greens, whichever pixel it
   // starts on: with the two green sites at 100 and 51, each registered pixel is (blue,
   // (100 + 51 + 1) / 2, red) exactly, for every pattern and every phase of the quad.
-  const auto stage = make_registration(kPaperRig);
   const ref::Rig rig = ref::rig_from(paper_rig());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
-  for (const PixelFormat format : kBayerFormats) {
+  for (const auto& [format, level] : every_pattern_at_every_level()) {
+    SCOPED_TRACE(level);
+    const auto stage = make_registration(kPaperRig, "nearest", 10.0, level);
     cv::Mat mosaic_image(1024, 1280, CV_8UC1);
     for (int y = 0; y < mosaic_image.rows; ++y) {
       for (int x = 0; x < mosaic_image.cols; ++x) {
