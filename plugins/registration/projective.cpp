@@ -102,13 +102,14 @@ struct Scratch {
     std::memset(nearest_mm.data(), kFarByte, nearest_mm.size() * sizeof(float));
   }
 
-  // Projects depth row `v` and finds each point's pixels for the sampler and its cell.
+  // Projects depth row `v` and finds each point's cell and, unless `cells_only`, the
+  // pixels for the sampler.
   LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                    int v, const Addressing& addressing) {
+                    int v, const Addressing& addressing, bool cells_only = false) {
     map.project_row(v, depth.ptr<float>(v), color_u.data(), color_v.data(), color_depth.data());
     map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
                          map.row_capacity(), color_u.data(), color_v.data(), color_depth.data(),
-                         key.data(), cell.data());
+                         cells_only ? nullptr : key.data(), cell.data());
     return {color_u.data(), color_v.data(), color_depth.data(), key.data(), cell.data()};
   }
 };
@@ -118,7 +119,7 @@ void fill_z_buffer(const DepthToColor& map, const OcclusionCells& cells, const c
                    const Addressing& addressing, Scratch& scratch) {
   scratch.prepare(map, cells);
   for (int v = 0; v < map.depth_height(); ++v) {
-    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing);
+    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing, true);
     map.kernels().keep_nearest(cells.grid(), map.row_capacity(), row.depth_mm, row.cell,
                                scratch.nearest_mm.data());
   }

@@ -8,7 +8,7 @@
 #include <limits>
 #include <utility>
 
-#if defined(__AVX2__)
+#if defined(__AVX__)
 #include <immintrin.h>
 #endif
 
@@ -89,6 +89,22 @@ constexpr Vector lanes_of(Lane lane) {
 #endif
 }
 
+// 1 / x to within 2 float ulps: the vector division takes 8 to 10 cycles a vector where
+// the hardware's estimate, refined by one Newton-Raphson step, takes 3 instructions. x =
+// 0 gives NaN, where the division gives infinity; the projection does not show either.
+[[gnu::always_inline]] inline Floats reciprocal(const Floats& x) {
+#if defined(__AVX512F__)
+  const Floats estimate =
+      reinterpret_cast<Floats>(_mm512_maskz_rcp14_ps(0xffff, reinterpret_cast<__m512>(x)));
+  return estimate * (2.0f - x * estimate);
+#elif defined(__AVX__)
+  const Floats estimate = reinterpret_cast<Floats>(_mm256_rcp_ps(reinterpret_cast<__m256>(x)));
+  return estimate * (2.0f - x * estimate);
+#else
+  return 1.0f / x;
+#endif
+}
+
 // The model's numbers as vectors, held in registers: loop stores through float pointers
 // could alias the model, so its fields would be loaded again for every vector.
 template <bool kSeparable, bool kDistorted>
@@ -137,7 +153,7 @@ void project_vectors(const ProjectionModel& m, const float* xs, const float* ys,
     }
     // P_c = R * (depth * (x', y', 1)) + T
     const Floats pz = depth * rz + tz;
-    const Floats inverse = one / pz;
+    const Floats inverse = reciprocal(pz);
     Floats nx = (depth * rx + tx) * inverse;
     Floats ny = (depth * ry + ty) * inverse;
     Ints shown = pz > zero;  // NaN compares false: no depth is not shown
@@ -334,7 +350,10 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
     yf = yf < y_end ? yf : y_end;
     const Ints x = __builtin_convertvector(xf, Ints) - 1;
     const Ints y = __builtin_convertvector(yf, Ints) - 1;
-    store(keys + i, y * row_key + x * column_key + (-(y & 1) & odd_row) + (-(x & 1) & odd_column));
+    if (keys != nullptr) {
+      store(keys + i,
+            y * row_key + x * column_key + (-(y & 1) & odd_row) + (-(x & 1) & odd_column));
+    }
     // Shown points have -0.5 <= u < width - 0.5: u + 0.5 truncates to its floor.
     const Ints cell = __builtin_convertvector((v + half) * per_cell, Ints) * columns +
                       __builtin_convertvector((u + half) * per_cell, Ints);

@@ -68,7 +68,7 @@ struct RowKernels {
                   const float* z_mm, float* color_u, float* color_v, float* color_depth);
   // For `count` projected points (a multiple of kRowLanes): the key of the pixels
   // nearest sampling reads (Addressing; clamped to the image, so that a point not shown
-  // reads pixels too) and the cell.
+  // reads pixels too; keys may be null) and the cell.
   void (*locate)(const Addressing& addressing, const CellGrid& cells, int color_width,
                  int color_height, int count, const float* color_u, const float* color_v,
                  const float* color_depth, int* keys, int* cell_indices);
