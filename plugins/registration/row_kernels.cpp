@@ -233,24 +233,39 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
 }
 
 // The colour of each lane's key as blue | green << 8 | red << 16.
-template <bool kQuad>
+// How a pixel word holds its colour: as blue | green << 8 | red << 16 already (bgr8), as
+// one pixel's bytes in any order, or as a 2x2 quad.
+enum class WordKind { kBgr, kPixel, kQuad };
+
+WordKind word_kind(const PixelWord& pixels) {
+  if (pixels.second_row != 0) return WordKind::kQuad;
+  const auto& sites = pixels.sites;
+  const bool bgr = sites[0] == 0 && sites[1] == 1 && sites[2] == 1 && sites[3] == 2;
+  return pixels.phase_mask == 0 && bgr ? WordKind::kBgr : WordKind::kPixel;
+}
+
+template <WordKind kKind>
 [[gnu::always_inline]] inline void read_colors(Words& colors, const PixelWord& pixels,
                                                const Ints& key) {
   const Ints offset = key >> pixels.key_shift;
   const Ints last = Ints{} + static_cast<int>(pixels.size - 4);
   Words word;
   read_words(word, pixels.data, offset, last);
-  if constexpr (kQuad) {
-    Words second;
-    read_words(second, pixels.data, offset + static_cast<int>(pixels.second_row), last);
-    word = (word & 0xffffu) | (second << 16);
+  if constexpr (kKind == WordKind::kBgr) {
+    colors = word & 0xffffffu;
+  } else {
+    if constexpr (kKind == WordKind::kQuad) {
+      Words second;
+      read_words(second, pixels.data, offset + static_cast<int>(pixels.second_row), last);
+      word = (word & 0xffffu) | (second << 16);
+    }
+    const Words phase = reinterpret_cast<Words>(key & pixels.phase_mask);
+    const auto channel = [&](int site) {
+      return (word >> ((phase ^ static_cast<std::uint32_t>(site)) << 3)) & 0xffu;
+    };
+    const Words green = (channel(pixels.sites[1]) + channel(pixels.sites[2]) + 1) >> 1;
+    colors = channel(pixels.sites[0]) | (green << 8) | (channel(pixels.sites[3]) << 16);
   }
-  const Words phase = reinterpret_cast<Words>(key & pixels.phase_mask);
-  const auto channel = [&](int site) {
-    return (word >> ((phase ^ static_cast<std::uint32_t>(site)) << 3)) & 0xffu;
-  };
-  const Words green = (channel(pixels.sites[1]) + channel(pixels.sites[2]) + 1) >> 1;
-  colors = channel(pixels.sites[0]) | (green << 8) | (channel(pixels.sites[3]) << 16);
 }
 
 // Each lane's blue, green and red bytes, packed: the 3 low bytes of each word within each
@@ -267,7 +282,7 @@ template <bool kQuad>
   std::memcpy(bgr, &packed, static_cast<std::size_t>(bytes));
 }
 
-template <bool kQuad>
+template <WordKind kKind>
 void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int count,
                      const float* z_mm, const float* color_depth, const int* cell_indices,
                      const int* keys, std::uint8_t* status, std::uint8_t* bgr) {
@@ -301,7 +316,7 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
     const Bytes codes = __builtin_convertvector(code, Bytes);
     std::memcpy(status + i, &codes, static_cast<std::size_t>(lanes));
     Words colors;
-    read_colors<kQuad>(colors, pixels, key);
+    read_colors<kKind>(colors, pixels, key);
     pack_bgr(bgr + 3 * i, colors & reinterpret_cast<Words>(visible), bgr_bytes);
   };
   // While a whole vector follows, a vector's colours are written as whole words: their
@@ -317,10 +332,17 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
 void resolve(const Visibility& visibility, const PixelWord& pixels, int count, const float* z_mm,
              const float* color_depth, const int* cell_indices, const int* keys,
              std::uint8_t* status, std::uint8_t* bgr) {
-  pixels.second_row != 0 ? resolve_vectors<true>(visibility, pixels, count, z_mm, color_depth,
-                                                 cell_indices, keys, status, bgr)
-                         : resolve_vectors<false>(visibility, pixels, count, z_mm, color_depth,
-                                                  cell_indices, keys, status, bgr);
+  switch (word_kind(pixels)) {
+    case WordKind::kBgr:
+      return resolve_vectors<WordKind::kBgr>(visibility, pixels, count, z_mm, color_depth,
+                                             cell_indices, keys, status, bgr);
+    case WordKind::kPixel:
+      return resolve_vectors<WordKind::kPixel>(visibility, pixels, count, z_mm, color_depth,
+                                               cell_indices, keys, status, bgr);
+    case WordKind::kQuad:
+      return resolve_vectors<WordKind::kQuad>(visibility, pixels, count, z_mm, color_depth,
+                                              cell_indices, keys, status, bgr);
+  }
 }
 
 // The sampler's top-left pixel x = floor(u + (1 - span) / 2 + 0.5) = trunc(u + 2 -
