@@ -34,11 +34,22 @@ namespace {
 // Scales the median absolute deviation to the standard deviation of normal data.
 constexpr double kMadToSigma = 1.4826;
 
-// The median (the mean of the middle two for an even count) of the indexed values.
-double median(RankSelection& ranks, std::size_t count) {
-  const float upper = ranks.at_rank(count / 2);
-  if (count % 2 == 1) return upper;
-  return 0.5 * (static_cast<double>(ranks.at_rank(count / 2 - 1)) + static_cast<double>(upper));
+// How far a depth lies from the median, as the spread's ranks see it.
+float deviation(float depth_mm, double median_mm) {
+  return static_cast<float>(std::abs(depth_mm - median_mm));
+}
+
+// Each depth replaced by deviation(depth, median_mm), two at a time in double precision.
+void replace_by_deviations(std::span<float> depths, double median_mm) {
+  const cv::v_float64x2 median = cv::v_setall_f64(median_mm);
+  std::size_t i = 0;
+  for (; i + 4 <= depths.size(); i += 4) {
+    const cv::v_float32x4 four = cv::v_load(depths.data() + i);
+    const cv::v_float64x2 low = cv::v_abs(cv::v_cvt_f64(four) - median);
+    const cv::v_float64x2 high = cv::v_abs(cv::v_cvt_f64_high(four) - median);
+    cv::v_store(depths.data() + i, cv::v_cvt_f32(low, high));
+  }
+  for (; i < depths.size(); ++i) depths[i] = deviation(depths[i], median_mm);
 }
 
 // The mean of what is left after dropping `trim_fraction` of the indexed values at each end.
@@ -74,42 +85,59 @@ class GroundDistanceEstimator final : public Transform {
     }
 
     thread_local std::vector<float> buffer;
-    const std::span<float> depths = collect_finite(soil.mm, roi, buffer);
+    const SoilDepths depths = collect_finite(soil.mm, roi, buffer);
     const auto message = outputs_.acquire();
     GroundDistance& out = *message;
     out = GroundDistance{};  // a reused message keeps its string's buffer
-    out.soil_pixels = static_cast<std::int64_t>(depths.size());
-    out.soil_fraction = static_cast<double>(depths.size()) / roi.area();
+    out.soil_pixels = static_cast<std::int64_t>(depths.mm.size());
+    out.soil_fraction = static_cast<double>(depths.mm.size()) / roi.area();
     out.invalid_reason = requirement_.shortfall(out.soil_pixels, roi.area());
     if (out.invalid_reason.empty()) measure(depths, out);
     frame.set_output(0, message);
   }
 
  private:
+  // The finite depths of a region and their range (lowest > highest when there are none).
+  struct SoilDepths {
+    std::span<float> mm;
+    float lowest;
+    float highest;
+  };
+
   // Four pixels at a time: soil and residue come in patches, so four depths are mostly
   // all finite or all not. Mixed groups are stored without a branch per pixel: every
-  // depth is stored, and the count moves on past the finite ones.
-  static std::span<float> collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
-                                         std::vector<float>& depths) {
+  // depth is stored, and the count moves on past the finite ones. The range comes with
+  // them, the other lanes held at the far end.
+  static SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
+                                   std::vector<float>& depths) {
     // One slot more for the last store. Never shrunk, so no frame after the first
     // allocates or clears it.
     const auto slots = static_cast<std::size_t>(roi.area()) + 1;
     if (depths.size() < slots) depths.resize(slots);
     float* const out = depths.data();
     std::size_t count = 0;
+    constexpr float kLargest = std::numeric_limits<float>::max();
+    float lowest = kLargest;
+    float highest = -kLargest;
     const auto collect = [&](const float* depth, int first, int end) {
       for (int col = first; col < end; ++col) {
         out[count] = depth[col];
         count += std::isfinite(depth[col]) ? 1 : 0;
       }
     };
-    const cv::v_float32x4 largest = cv::v_setall_f32(std::numeric_limits<float>::max());
+    const cv::v_float32x4 largest = cv::v_setall_f32(kLargest);
+    const cv::v_float32x4 smallest = cv::v_setall_f32(-kLargest);
+    cv::v_float32x4 low = largest;
+    cv::v_float32x4 high = smallest;
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
       const float* depth = depth_mm.ptr<float>(row);
       int col = roi.x;
       for (; col + 4 <= roi.x + roi.width; col += 4) {
         const cv::v_float32x4 four = cv::v_load(depth + col);
-        const int finite = cv::v_signmask(cv::v_abs(four) <= largest);  // NaN, inf: false
+        const cv::v_float32x4 finite_lanes = cv::v_abs(four) <= largest;  // NaN, inf: false
+        low = cv::v_min(low, cv::v_select(finite_lanes, four, largest));
+        high = cv::v_max(high, cv::v_select(finite_lanes, four, smallest));
+        const int finite = cv::v_signmask(finite_lanes);
         if (finite == 0xF) {
           cv::v_store(out + count, four);
           count += 4;
@@ -118,21 +146,31 @@ class GroundDistanceEstimator final : public Transform {
         }
       }
       collect(depth, col, roi.x + roi.width);
+      for (; col < roi.x + roi.width; ++col) {
+        if (!std::isfinite(depth[col])) continue;
+        lowest = std::min(lowest, depth[col]);
+        highest = std::max(highest, depth[col]);
+      }
     }
-    return {out, count};
+    return {{out, count},
+            std::min(lowest, cv::v_reduce_min(low)),
+            std::max(highest, cv::v_reduce_max(high))};
   }
 
-  // The trimmed mean, the median and the spread from one histogram of the depths each.
-  void measure(std::span<float> depths, GroundDistance& out) const {
+  // The trimmed mean, the median and the spread from one histogram of the depths and one
+  // of their deviations from the median, which lie between 0 and those of the extremes.
+  void measure(const SoilDepths& depths, GroundDistance& out) const {
     thread_local RankSelection ranks;
-    const std::size_t count = depths.size();
-    ranks.index(depths);
-    const double median_mm = median(ranks, count);
-    const double distance_mm =
-        statistic_ == Statistic::kMedian ? median_mm : trimmed_mean(ranks, count, trim_fraction_);
-    for (float& depth : depths) depth = static_cast<float>(std::abs(depth - median_mm));
-    ranks.index(depths);
-    out.spread_mm = kMadToSigma * median(ranks, count);
+    ranks.index(depths.mm, depths.lowest, depths.highest);
+    const double median_mm = ranks.median();
+    const double distance_mm = statistic_ == Statistic::kMedian
+                                   ? median_mm
+                                   : trimmed_mean(ranks, depths.mm.size(), trim_fraction_);
+    replace_by_deviations(depths.mm, median_mm);
+    ranks.index(
+        depths.mm, 0.0f,
+        std::max(deviation(depths.lowest, median_mm), deviation(depths.highest, median_mm)));
+    out.spread_mm = kMadToSigma * ranks.median();
     if (max_spread_mm_ > 0 && out.spread_mm > max_spread_mm_) {
       out.invalid_reason = "soil depths spread too widely: " + one_decimal(out.spread_mm) +
                            " mm > " + one_decimal(max_spread_mm_) + " mm (not one surface?)";

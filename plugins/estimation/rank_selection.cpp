@@ -12,9 +12,6 @@ namespace {
 // Fine enough that a bin holds a small share of a frame's soil depths, small enough that
 // the counts stay in the L1 cache.
 constexpr std::size_t kBins = 4096;
-// Values counted into separate histograms in turn, so that runs of values in one bin do
-// not wait for each other's increments.
-constexpr std::size_t kHistograms = 4;
 constexpr int kLanes = 4;  // cv::v_float32x4
 
 std::pair<float, float> range(std::span<const float> values) {
@@ -42,12 +39,21 @@ std::pair<float, float> range(std::span<const float> values) {
 }  // namespace
 
 void RankSelection::index(std::span<const float> values) {
+  if (values.empty()) {
+    index(values, 0.0f, 0.0f);
+    return;
+  }
+  const auto [lowest, highest] = range(values);
+  index(values, lowest, highest);
+}
+
+void RankSelection::index(std::span<const float> values, float lowest, float highest) {
   values_ = values;
   below_bin_.assign(kBins + 1, 0);
   if (values.empty()) return;
   const std::size_t count = values.size();
   bin_of_value_.resize(count);
-  const auto [lowest, highest] = range(values);
+  counts_.assign(2 * kBins, 0);
   // Each step (subtract, scale, clamp, truncate) is monotone, so a larger value never
   // lands in an earlier bin: the values of rank k lie in the bin where the counts say.
   // Float overflow only makes a difference infinite, which the clamp takes to the last bin.
@@ -58,6 +64,7 @@ void RankSelection::index(std::span<const float> values) {
   const auto bin_of = [&](float value) {
     return static_cast<std::uint16_t>(std::min((value - lowest) * scale, last_bin));
   };
+  std::uint16_t* const bins = bin_of_value_.data();
   std::size_t i = 0;
   const cv::v_float32x4 low = cv::v_setall_f32(lowest);
   const cv::v_float32x4 factor = cv::v_setall_f32(scale);
@@ -66,60 +73,80 @@ void RankSelection::index(std::span<const float> values) {
     return cv::v_trunc(cv::v_min((cv::v_load(values.data() + first) - low) * factor, last));
   };
   for (; i + 2 * kLanes <= count; i += 2 * kLanes) {
-    const cv::v_int16x8 bins = cv::v_pack(bins_of(i), bins_of(i + kLanes));  // < 4096: exact
-    cv::v_store(bin_of_value_.data() + i, cv::v_reinterpret_as_u16(bins));
+    const cv::v_int16x8 eight = cv::v_pack(bins_of(i), bins_of(i + kLanes));  // < 4096: exact
+    cv::v_store(bins + i, cv::v_reinterpret_as_u16(eight));
   }
-  for (; i < count; ++i) bin_of_value_[i] = bin_of(values[i]);
-
-  counts_.assign(kHistograms * kBins, 0);
-  const std::uint16_t* bins = bin_of_value_.data();
-  for (i = 0; i + kHistograms <= count; i += kHistograms) {
-    for (std::size_t h = 0; h < kHistograms; ++h) ++counts_[h * kBins + bins[i + h]];
+  for (; i < count; ++i) bins[i] = bin_of(values[i]);
+  // Two histograms, the values in turn, so that a run of values in one bin does not wait
+  // for each increment before the next. Through local pointers, which no store changes.
+  std::uint32_t* const counts = counts_.data();
+  std::uint32_t* const other_counts = counts + kBins;
+  for (i = 0; i + 2 <= count; i += 2) {
+    ++counts[bins[i]];
+    ++other_counts[bins[i + 1]];
   }
-  for (; i < count; ++i) ++counts_[bins[i]];
+  if (i < count) ++counts[bins[i]];
   for (std::size_t bin = 0; bin < kBins; ++bin) {
-    std::uint32_t in_bin = 0;
-    for (std::size_t h = 0; h < kHistograms; ++h) in_bin += counts_[h * kBins + bin];
-    below_bin_[bin + 1] = below_bin_[bin] + in_bin;
+    below_bin_[bin + 1] = below_bin_[bin] + counts[bin] + other_counts[bin];
   }
 }
 
-std::size_t RankSelection::gather_bin_of_rank(std::size_t k) {
-  const auto bin = static_cast<std::size_t>(
-      std::upper_bound(below_bin_.begin(), below_bin_.end(), k) - below_bin_.begin() - 1);
-  // Eight values' bins are compared at once; only groups with one in the bin are gathered,
-  // without a branch per value: each is stored, and the count moves on past the bin's own.
-  // One slot more for the last store.
-  candidates_.resize(below_bin_[bin + 1] - below_bin_[bin] + 1);
+std::size_t RankSelection::bin_of_rank(std::size_t k) const {
+  return static_cast<std::size_t>(std::upper_bound(below_bin_.begin(), below_bin_.end(), k) -
+                                  below_bin_.begin() - 1);
+}
+
+void RankSelection::gather_bins(std::size_t first, std::size_t last) {
+  // Eight values' bins are compared at once; only groups with one in the bins are
+  // gathered, without a branch per value: each is stored, and the count moves on past
+  // those in the bins. One slot more for the last store.
+  candidates_.resize(below_bin_[last + 1] - below_bin_[first] + 1);
   const std::uint16_t* bins = bin_of_value_.data();
-  const auto wanted = static_cast<std::uint16_t>(bin);
-  const cv::v_uint16x8 wanted8 = cv::v_setall_u16(wanted);
+  const auto lowest = static_cast<std::uint16_t>(first);
+  const auto span = static_cast<std::uint16_t>(last - first);
+  const cv::v_uint16x8 lowest8 = cv::v_setall_u16(lowest);
+  const cv::v_uint16x8 span8 = cv::v_setall_u16(span);
   std::size_t count = 0;
-  const auto gather = [&](std::size_t first, std::size_t end) {
-    for (std::size_t i = first; i < end; ++i) {
+  const auto gather = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
       candidates_[count] = values_[i];
-      count += bins[i] == wanted ? 1 : 0;
+      count += static_cast<std::uint16_t>(bins[i] - lowest) <= span ? 1 : 0;
     }
   };
   std::size_t i = 0;
   for (; i + 8 <= values_.size(); i += 8) {
-    if (cv::v_check_any(cv::v_load(bins + i) == wanted8)) gather(i, i + 8);
+    if (cv::v_check_any(cv::v_sub_wrap(cv::v_load(bins + i), lowest8) <= span8)) gather(i, i + 8);
   }
   gather(i, values_.size());
-  return bin;
 }
 
 float RankSelection::at_rank(std::size_t k) {
-  const std::size_t bin = gather_bin_of_rank(k);
+  const std::size_t bin = bin_of_rank(k);
+  gather_bins(bin, bin);
   const auto end = candidates_.end() - 1;
   const auto kth = candidates_.begin() + static_cast<std::ptrdiff_t>(k - below_bin_[bin]);
   std::nth_element(candidates_.begin(), kth, end);
   return *kth;
 }
 
+double RankSelection::median() {
+  const std::size_t upper = values_.size() / 2;
+  if (values_.size() % 2 == 1) return at_rank(upper);
+  // Both middle values from one gathering: the lower is the largest of those the
+  // selection of the upper puts before it.
+  const std::size_t first = bin_of_rank(upper - 1);
+  gather_bins(first, bin_of_rank(upper));
+  const auto end = candidates_.end() - 1;
+  const auto kth = candidates_.begin() + static_cast<std::ptrdiff_t>(upper - below_bin_[first]);
+  std::nth_element(candidates_.begin(), kth, end);
+  const float lower = *std::max_element(candidates_.begin(), kth);
+  return 0.5 * (static_cast<double>(lower) + static_cast<double>(*kth));
+}
+
 double RankSelection::sum_of_smallest(std::size_t k) {
   if (k == 0) return 0.0;
-  const std::size_t bin = gather_bin_of_rank(k - 1);
+  const std::size_t bin = bin_of_rank(k - 1);
+  gather_bins(bin, bin);
   double sum = 0.0;
   for (std::size_t i = 0; i < values_.size(); ++i) {
     sum += bin_of_value_[i] < bin ? static_cast<double>(values_[i]) : 0.0;

@@ -1,13 +1,32 @@
 #include "color_range_table.h"
 
+#include <sys/mman.h>
+
+#include <new>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace tilth::segmentation {
+namespace {
+
+constexpr std::size_t kColors = std::size_t{1} << 24;
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+
+// Asked for before the first write, which is when the pages are made. Where transparent
+// huge pages are off, the advice is ignored and the table has ordinary pages.
+std::uint8_t* allocate_on_huge_pages() {
+  void* bytes = std::aligned_alloc(kHugePage, kColors);
+  if (bytes == nullptr) throw std::bad_alloc();
+  madvise(bytes, kColors, MADV_HUGEPAGE);
+  return static_cast<std::uint8_t*>(bytes);
+}
+
+}  // namespace
 
 ColorRangeTable::ColorRangeTable(int conversion, const std::array<int, 3>& lower,
                                  const std::array<int, 3>& upper)
-    : in_range_(std::size_t{1} << 24) {
+    : in_range_(allocate_on_huge_pages()) {
   // One red value at a time: a 256x256 image of every (blue, green), blue along a row,
   // so that pixel (g, b) is colour b + 256 g + 65536 r, and the in-range result for that
   // red value is the table's 2^16 bytes from 65536 r on.
@@ -27,7 +46,7 @@ ColorRangeTable::ColorRangeTable(int conversion, const std::array<int, 3>& lower
     } else {
       converted = colors;
     }
-    cv::Mat in_range(256, 256, CV_8UC1, in_range_.data() + (static_cast<std::size_t>(r) << 16));
+    cv::Mat in_range(256, 256, CV_8UC1, in_range_.get() + (static_cast<std::size_t>(r) << 16));
     cv::inRange(converted, low, high, in_range);
   }
 }

@@ -123,8 +123,8 @@ ColorRangeTable residue_colors(const Params& params) {
 // Per-thread working masks: the stage runs frames concurrently, and these keep their
 // buffers from one frame to the next on the same thread.
 struct Scratch {
-  BitMask residue;  // trusted colour in the residue range; then despeckled and dilated
-  BitMask unknown;  // untrusted colour or no depth
+  BitMask residue;    // trusted colour in the residue range; then despeckled and dilated
+  BitMask untrusted;  // colour not kValid, or darker than min_value
   std::vector<std::uint8_t> in_range;  // one row: 255 where the colour is in the range
   std::vector<std::uint8_t> dark;      // one row: 255 where every channel is below min_value
 };
@@ -141,21 +141,21 @@ class ColorThreshold final : public Transform {
     const auto& depth = frame.input<DepthImage>(kDepthInput);
     check_residue_inputs(color, depth);
     thread_local Scratch scratch;
-    min_value_ > 0 ? classify<true>(color, depth.mm, scratch)
-                   : classify<false>(color, depth.mm, scratch);
-    output_.emit(frame, scratch.residue, scratch.unknown, depth.mm);
+    min_value_ > 0 ? classify<true>(color, scratch) : classify<false>(color, scratch);
+    // Pixels without depth are unknown too: emit finds them as it writes the soil depth.
+    output_.emit(frame, scratch.residue, scratch.untrusted, depth.mm);
   }
 
  private:
-  // Marks, per pixel, residue (a trusted colour in the range) and unknown (an untrusted
-  // colour, or no depth). An untrusted colour may fall in the range by chance (an occluded
-  // pixel carries the colour of what hides it); it must not grow into its neighbours.
+  // Marks, per pixel, residue (a trusted colour in the range) and untrusted. An untrusted
+  // colour may fall in the range by chance (an occluded pixel carries the colour of what
+  // hides it); it must not grow into its neighbours.
   template <bool kCheckDark>
-  void classify(const RegisteredColor& color, const cv::Mat& depth_mm, Scratch& scratch) const {
-    const int rows = depth_mm.rows;
-    const int cols = depth_mm.cols;
+  void classify(const RegisteredColor& color, Scratch& scratch) const {
+    const int rows = color.bgr.rows;
+    const int cols = color.bgr.cols;
     scratch.residue.resize(rows, cols);
-    scratch.unknown.resize(rows, cols);
+    scratch.untrusted.resize(rows, cols);
     scratch.in_range.resize(static_cast<std::size_t>(cols));
     scratch.dark.resize(kCheckDark ? static_cast<std::size_t>(cols) : 0);
     std::uint8_t* const in_range = scratch.in_range.data();
@@ -182,9 +182,8 @@ class ColorThreshold final : public Transform {
         }
       }
       const auto* status = color.status.ptr<std::uint8_t>(y);
-      const auto* depth = depth_mm.ptr<float>(y);
       std::uint64_t* residue = scratch.residue.row(y);
-      std::uint64_t* unknown = scratch.unknown.row(y);
+      std::uint64_t* untrusted = scratch.untrusted.row(y);
       for (int x = 0; x < cols; x += 64) {
         const int count = std::min(64, cols - x);
         const std::uint64_t dark_bits = kCheckDark ? marked_bits(dark + x, count) : 0;
@@ -192,7 +191,7 @@ class ColorThreshold final : public Transform {
         const std::uint64_t pixels =
             count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
         residue[x / 64] = marked_bits(in_range + x, count) & trusted;
-        unknown[x / 64] = (~trusted | missing_depth_bits(depth + x, count)) & pixels;
+        untrusted[x / 64] = ~trusted & pixels;
       }
     }
   }

@@ -69,9 +69,9 @@ class ResidueOutput {
             const cv::Mat& unknown, const cv::Mat& depth_mm);
 
   // The same from bit masks (BitMask), `residue` consumed: specks narrower than
-  // 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels marked in `unknown`
-  // become kUnknown; the depth of the remaining soil pixels is the soil depth. Sets both
-  // outputs of `frame`.
+  // 2*speckle_px+1 go; the rest is dilated by dilation_px; pixels marked in `unknown`, and
+  // those whose depth is NaN, become kUnknown; the depth of the remaining soil pixels is
+  // the soil depth. Sets both outputs of `frame`.
   void emit(Frame& frame, BitMask& residue, const BitMask& unknown, const cv::Mat& depth_mm);
 
  private:

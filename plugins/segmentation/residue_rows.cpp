@@ -37,6 +37,11 @@ constexpr std::array<std::array<std::uint32_t, 4>, 16> kLaneMasks = [] {
 
 constexpr std::uint64_t every_byte(std::uint8_t value) { return value * 0x0101010101010101u; }
 
+// All ones in lane i where bit i of `bits` is set; bits from 4 on are ignored.
+cv::v_float32x4 lanes(unsigned bits) {
+  return cv::v_reinterpret_as_f32(cv::v_load(kLaneMasks[bits & 15].data()));
+}
+
 }  // namespace
 
 std::uint64_t marked_bits(const std::uint8_t* bytes, int count) {
@@ -62,40 +67,30 @@ std::uint64_t valid_status_bits(const std::uint8_t* status, int count) {
   return bits;
 }
 
-std::uint64_t missing_depth_bits(const float* depth_mm, int count) {
-  std::uint64_t bits = 0;
-  int i = 0;
-  for (; i + 4 <= count; i += 4) {
-    const cv::v_float32x4 depth = cv::v_load(depth_mm + i);
-    const auto lanes = static_cast<std::uint32_t>(cv::v_signmask(depth != depth));  // NaN only
-    bits |= std::uint64_t{lanes} << i;
-  }
-  for (; i < count; ++i) bits |= std::uint64_t{depth_mm[i] != depth_mm[i]} << i;
-  return bits;
-}
-
 void write_residue_row(const std::uint64_t* unknown, const std::uint64_t* residue,
                        const float* depth_mm, int cols, std::uint8_t* mask, float* soil_mm) {
   constexpr float kNoSoil = std::numeric_limits<float>::quiet_NaN();
   const cv::v_float32x4 no_soil = cv::v_setall_f32(kNoSoil);
   int x = 0;
   for (; x + 8 <= cols; x += 8) {  // eight pixels: one byte of each bit row
-    const unsigned unknown_bits = (unknown[x / 64] >> (x % 64)) & 0xFF;
-    const unsigned residue_bits = (residue[x / 64] >> (x % 64)) & 0xFF & ~unknown_bits;
+    const cv::v_float32x4 depth_low = cv::v_load(depth_mm + x);
+    const cv::v_float32x4 depth_high = cv::v_load(depth_mm + x + 4);
+    const auto missing = static_cast<unsigned>(cv::v_signmask(depth_low != depth_low) |
+                                               cv::v_signmask(depth_high != depth_high) << 4);
+    const unsigned marked_unknown = (unknown[x / 64] >> (x % 64)) & 0xFF;
+    const unsigned marked_residue = (residue[x / 64] >> (x % 64)) & 0xFF;
+    const unsigned unknown_bits = marked_unknown | missing;
+    const unsigned residue_bits = marked_residue & ~unknown_bits;
     const unsigned soil_bits = ~(unknown_bits | residue_bits) & 0xFF;
     const std::uint64_t values = (kByteMasks[unknown_bits] & every_byte(ResidueMask::kUnknown)) |
                                  (kByteMasks[residue_bits] & every_byte(ResidueMask::kResidue)) |
                                  (kByteMasks[soil_bits] & every_byte(ResidueMask::kSoil));
     std::memcpy(mask + x, &values, sizeof values);
-    for (int half = 0; half < 2; ++half) {
-      const cv::v_float32x4 soil =
-          cv::v_reinterpret_as_f32(cv::v_load(kLaneMasks[(soil_bits >> (4 * half)) & 15].data()));
-      const int i = x + 4 * half;
-      cv::v_store(soil_mm + i, cv::v_select(soil, cv::v_load(depth_mm + i), no_soil));
-    }
+    cv::v_store(soil_mm + x, cv::v_select(lanes(soil_bits), depth_low, no_soil));
+    cv::v_store(soil_mm + x + 4, cv::v_select(lanes(soil_bits >> 4), depth_high, no_soil));
   }
   for (; x < cols; ++x) {
-    const bool is_unknown = (unknown[x / 64] >> (x % 64)) & 1;
+    const bool is_unknown = ((unknown[x / 64] >> (x % 64)) & 1) || depth_mm[x] != depth_mm[x];
     const bool is_residue = (residue[x / 64] >> (x % 64)) & 1;
     mask[x] = is_unknown   ? ResidueMask::kUnknown
               : is_residue ? ResidueMask::kResidue

@@ -13,13 +13,10 @@ std::uint64_t marked_bits(const std::uint8_t* bytes, int count);
 // Bit i set where status[i] is RegisteredColor::kValid; `count` <= 64 pixels.
 std::uint64_t valid_status_bits(const std::uint8_t* status, int count);
 
-// Bit i set where depth_mm[i] is NaN; `count` <= 64 pixels.
-std::uint64_t missing_depth_bits(const float* depth_mm, int count);
-
-// One row of the outputs: a pixel is ResidueMask::kUnknown where its `unknown` bit is set,
-// otherwise kResidue where its `residue` bit is set, otherwise kSoil; its soil depth is
-// depth_mm where the mask says kSoil, NaN elsewhere. `unknown` and `residue` hold
-// (cols + 63) / 64 words.
+// One row of the outputs: a pixel is ResidueMask::kUnknown where its `unknown` bit is set
+// or its depth is NaN, otherwise kResidue where its `residue` bit is set, otherwise kSoil;
+// its soil depth is depth_mm where the mask says kSoil, NaN elsewhere. `unknown` and
+// `residue` hold (cols + 63) / 64 words.
 void write_residue_row(const std::uint64_t* unknown, const std::uint64_t* residue,
                        const float* depth_mm, int cols, std::uint8_t* mask, float* soil_mm);
 
