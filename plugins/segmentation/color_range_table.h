@@ -1,16 +1,17 @@
-// Which of the 2^24 BGR colours lie in a box of another colour space, one byte each
-// (16 MB): built once per parameter set with OpenCV's own conversion and in-range test, so
-// a lookup gives exactly what cv::cvtColor + cv::inRange would, for one load per pixel.
-// (A bit per colour, 2 MB, costs three more instructions per pixel to find the bit, and
-// the lookup is what the segmentation's time goes to; the colours of a frame touch a few
-// hundred KB of the table, but on a thousand or more 4 KB pages, too many for the TLB:
-// the table asks for 2 MB pages.)
+// Which of the 2^24 BGR colours lie in a box of another colour space: built once per
+// parameter set with OpenCV's own conversion and in-range test, so a lookup gives exactly
+// what cv::cvtColor + cv::inRange would. The table is a byte per colour (16 MB, on 2 MB
+// pages: a frame's colours lie on a thousand or more 4 KB pages, too many for the TLB),
+// unless for every green and red the box holds one run of blues (true of the HSV boxes of
+// soil and straw): then it is that run's first and last blue, 128 KB. A camera's noise
+// spreads a frame's colours over much of the 16 MB, and the lookups then wait on memory.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <vector>
 
 namespace tilth::segmentation {
 
@@ -20,21 +21,27 @@ class ColorRangeTable {
   // the box is in BGR itself. `lower`, `upper`: inclusive 8-bit bounds per channel.
   ColorRangeTable(int conversion, const std::array<int, 3>& lower, const std::array<int, 3>& upper);
 
-  // `bgr24`: blue in bits 0-7, green 8-15, red 16-23 (a BGR pixel's bytes read little-endian).
-  // 255 inside the box, 0 outside, as cv::inRange writes.
-  std::uint8_t in_range(std::uint32_t bgr24) const { return in_range_.get()[bgr24]; }
-  // The 2^24 bytes themselves, for loops that write bytes: through a pointer held in a
-  // local, the compiler need not reload it after every byte written.
-  const std::uint8_t* data() const { return in_range_.get(); }
-  bool contains(std::uint8_t b, std::uint8_t g, std::uint8_t r) const {
-    return in_range(b | (std::uint32_t{g} << 8) | (std::uint32_t{r} << 16)) != 0;
-  }
+  // For `count` BGR pixels (3 bytes each): 255 inside the box, 0 outside, as cv::inRange
+  // writes.
+  void classify_row(const std::uint8_t* bgr, int count, std::uint8_t* in_range) const;
+  bool contains(std::uint8_t b, std::uint8_t g, std::uint8_t r) const;
+
+  // Whether the table is held as one run of blues per (green, red), 128 KB, which the
+  // caches keep, rather than 16 MB (see above).
+  bool held_as_runs() const { return !runs_.empty(); }
 
  private:
+  struct Run {
+    std::uint8_t first, last;  // first > last: no blue
+  };
   struct Free {
     void operator()(std::uint8_t* bytes) const { std::free(bytes); }
   };
-  std::unique_ptr<std::uint8_t[], Free> in_range_;
+  // Keeps runs_ instead of the byte table where each (green, red) has one run.
+  void hold_as_runs_if_possible();
+
+  std::unique_ptr<std::uint8_t[], Free> in_range_;  // null when held as runs
+  std::vector<Run> runs_;                           // per green + 256 * red
 };
 
 }  // namespace tilth::segmentation

@@ -160,21 +160,9 @@ class ColorThreshold final : public Transform {
     scratch.dark.resize(kCheckDark ? static_cast<std::size_t>(cols) : 0);
     std::uint8_t* const in_range = scratch.in_range.data();
     std::uint8_t* const dark = scratch.dark.data();
-    const std::uint8_t* const table = residue_colors_.data();
     for (int y = 0; y < rows; ++y) {
       const auto* bgr = color.bgr.ptr<std::uint8_t>(y);
-      // The table lookup, one load per pixel, is the stage's main cost: each pixel's
-      // three bytes are read as one four-byte word, except the row's last pixel, whose
-      // fourth byte may lie beyond the image.
-      for (int x = 0; x + 1 < cols; ++x) {
-        std::uint32_t bytes;
-        std::memcpy(&bytes, bgr + 3 * x, sizeof bytes);
-        in_range[x] = table[bytes & 0xFFFFFF];
-      }
-      if (cols > 0) {
-        const std::uint8_t* last = bgr + 3 * (cols - 1);
-        in_range[cols - 1] = residue_colors_.contains(last[0], last[1], last[2]) ? 255 : 0;
-      }
+      residue_colors_.classify_row(bgr, cols, in_range);
       if constexpr (kCheckDark) {
         for (int x = 0; x < cols; ++x) {
           const std::uint8_t* pixel = bgr + 3 * x;

@@ -17,6 +17,7 @@ struct Box {
   int conversion;  // -1: the box is in BGR
   std::array<int, 3> lower;
   std::array<int, 3> upper;
+  bool held_as_runs;  // one run of blues for every green and red
 };
 
 class EachBox : public ::testing::TestWithParam<Box> {};
@@ -55,6 +56,13 @@ TEST_P(EachBox, AgreesWithCvtColorAndInRangeOnEveryColour) {
     }
   }
   EXPECT_EQ(mismatches, 0);
+  // A row at a time, as the stage reads a frame.
+  cv::Mat classified(colors.size(), CV_8UC1);
+  for (int y = 0; y < colors.rows; ++y) {
+    table.classify_row(colors.ptr<std::uint8_t>(y), colors.cols, classified.ptr<std::uint8_t>(y));
+  }
+  EXPECT_EQ(cv::countNonZero(classified != expected), 0);
+  EXPECT_EQ(table.held_as_runs(), box.held_as_runs);
   // The boxes are neither empty nor everything, so a table of one value would fail.
   EXPECT_GT(inside, 10000);
   EXPECT_LT(inside, (1 << 24) - 10000);
@@ -64,12 +72,12 @@ TEST_P(EachBox, AgreesWithCvtColorAndInRangeOnEveryColour) {
 // colour cube on every channel.
 INSTANTIATE_TEST_SUITE_P(
     ColorRangeTable, EachBox,
-    ::testing::Values(Box{"hsv", cv::COLOR_BGR2HSV, {18, 40, 50}, {40, 255, 255}},
-                      Box{"lab", cv::COLOR_BGR2Lab, {50, 110, 140}, {255, 132, 255}},
-                      Box{"bgr", -1, {0, 140, 160}, {255, 255, 255}},
-                      Box{"hsv_narrow", cv::COLOR_BGR2HSV, {10, 100, 90}, {16, 150, 130}},
-                      Box{"lab_narrow", cv::COLOR_BGR2Lab, {80, 130, 140}, {110, 145, 155}},
-                      Box{"bgr_narrow", -1, {40, 60, 90}, {70, 100, 130}}),
+    ::testing::Values(Box{"hsv", cv::COLOR_BGR2HSV, {18, 40, 50}, {40, 255, 255}, true},
+                      Box{"lab", cv::COLOR_BGR2Lab, {50, 110, 140}, {255, 132, 255}, false},
+                      Box{"bgr", -1, {0, 140, 160}, {255, 255, 255}, true},
+                      Box{"hsv_narrow", cv::COLOR_BGR2HSV, {10, 100, 90}, {16, 150, 130}, true},
+                      Box{"lab_narrow", cv::COLOR_BGR2Lab, {80, 130, 140}, {110, 145, 155}, false},
+                      Box{"bgr_narrow", -1, {40, 60, 90}, {70, 100, 130}, true}),
     [](const auto& info) { return info.param.name; });
 
 }  // namespace
