@@ -79,10 +79,13 @@ struct LocatedRow {
   const int* cell;        // CellGrid::outside: not in the colour image
 };
 
-// What a frame in flight needs besides its output: the z-buffer, a row of depth pixels
-// as the colour camera sees them, and the demosaiced colour image for bilinear sampling
-// of a mosaic. Each pass locates the rows anew: that costs less than the memory traffic
-// of keeping every row's locations from the first pass to the second.
+// What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
+// colour camera sees them, and the demosaiced colour image for bilinear sampling of a
+// mosaic. The second pass needs each row's locations again: with 16 lanes a vector
+// projecting and locating the row anew costs less than the memory traffic of keeping
+// every row's (12 bytes a pixel, 3.7 MB a frame), with 8 or 4 it costs more
+// (RowKernels::locate_again). Kept rows include their colour pixels for bilinear
+// sampling only, which reads them in the second pass.
 struct Scratch {
   // An empty cell's depth: the float whose bytes are all kFarByte, 3.4e38 mm, farther
   // than any point.
@@ -92,34 +95,69 @@ struct Scratch {
   std::vector<float> color_u, color_v, color_depth;
   std::vector<int> key, cell;
   cv::Mat demosaiced;  // CV_8UC3
+  bool keep_rows = false;
 
-  void prepare(const DepthToColor& map, const OcclusionCells& cells) {
+  void prepare(const DepthToColor& map, const OcclusionCells& cells, bool bilinear) {
+    keep_rows = !map.kernels().locate_again;
     const auto row = static_cast<std::size_t>(map.row_capacity());
-    for (auto* values : {&color_u, &color_v, &color_depth}) values->resize(row);
-    for (auto* values : {&key, &cell}) values->resize(row);
+    const auto frame = row * static_cast<std::size_t>(map.depth_height());
+    for (auto* values : {&color_u, &color_v}) values->resize(keep_rows && bilinear ? frame : row);
+    color_depth.resize(keep_rows ? frame : row);
+    for (auto* values : {&key, &cell}) values->resize(keep_rows ? frame : row);
     // Cleared to kFar with memset, the fastest way to clear it.
     nearest_mm.resize(static_cast<std::size_t>(cells.grid().count()));
     std::memset(nearest_mm.data(), kFarByte, nearest_mm.size() * sizeof(float));
   }
 
-  // Projects depth row `v` and finds each point's cell and, unless `cells_only`, the
-  // pixels for the sampler.
+  // The first pass: projects depth row `v` and finds each point's cell and, when the row
+  // is kept, the pixels for the sampler.
+  LocatedRow locate_first(const DepthToColor& map, const OcclusionCells& cells,
+                          const cv::Mat& depth, int v, const Addressing& addressing) {
+    return locate(map, cells, depth, v, addressing, !keep_rows);
+  }
+
+  // The second pass: row `v` as kept, or located again.
+  LocatedRow locate_second(const DepthToColor& map, const OcclusionCells& cells,
+                           const cv::Mat& depth, int v, const Addressing& addressing) {
+    return keep_rows ? row_at(map, v) : locate(map, cells, depth, v, addressing, false);
+  }
+
+ private:
+  struct Slots {
+    float *u, *v, *depth_mm;
+    int *key, *cell;
+  };
+
   LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                    int v, const Addressing& addressing, bool cells_only = false) {
-    map.project_row(v, depth.ptr<float>(v), color_u.data(), color_v.data(), color_depth.data());
+                    int v, const Addressing& addressing, bool cells_only) {
+    const Slots row = slots(map, v);
+    map.project_row(v, depth.ptr<float>(v), row.u, row.v, row.depth_mm);
     map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
-                         map.row_capacity(), color_u.data(), color_v.data(), color_depth.data(),
-                         cells_only ? nullptr : key.data(), cell.data());
-    return {color_u.data(), color_v.data(), color_depth.data(), key.data(), cell.data()};
+                         map.row_capacity(), row.u, row.v, row.depth_mm,
+                         cells_only ? nullptr : row.key, row.cell);
+    return {row.u, row.v, row.depth_mm, row.key, row.cell};
+  }
+
+  LocatedRow row_at(const DepthToColor& map, int v) {
+    const Slots row = slots(map, v);
+    return {row.u, row.v, row.depth_mm, row.key, row.cell};
+  }
+
+  Slots slots(const DepthToColor& map, int v) {
+    const auto capacity = static_cast<std::size_t>(map.row_capacity());
+    const std::size_t start = keep_rows ? static_cast<std::size_t>(v) * capacity : 0;
+    const std::size_t uv = color_u.size() > start ? start : 0;
+    return {color_u.data() + uv, color_v.data() + uv, color_depth.data() + start,
+            key.data() + start, cell.data() + start};
   }
 };
 
 // The first pass: the nearest point of each cell.
 void fill_z_buffer(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                   const Addressing& addressing, Scratch& scratch) {
-  scratch.prepare(map, cells);
+                   const Addressing& addressing, bool bilinear, Scratch& scratch) {
+  scratch.prepare(map, cells, bilinear);
   for (int v = 0; v < map.depth_height(); ++v) {
-    const LocatedRow row = scratch.locate(map, cells, depth, v, addressing, true);
+    const LocatedRow row = scratch.locate_first(map, cells, depth, v, addressing);
     map.kernels().keep_nearest(cells.grid(), map.row_capacity(), row.depth_mm, row.cell,
                                scratch.nearest_mm.data());
   }
@@ -134,10 +172,10 @@ Visibility visibility(const Scratch& scratch, const OcclusionCells& cells, float
 void register_nearest(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
                       const NearestPixels& pixels, float occlusion_tolerance_mm, Scratch& scratch,
                       RegisteredColor& out) {
-  fill_z_buffer(map, cells, depth, pixels.addressing, scratch);
+  fill_z_buffer(map, cells, depth, pixels.addressing, false, scratch);
   const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
   for (int v = 0; v < map.depth_height(); ++v) {
-    const LocatedRow row = scratch.locate(map, cells, depth, v, pixels.addressing);
+    const LocatedRow row = scratch.locate_second(map, cells, depth, v, pixels.addressing);
     map.kernels().resolve(seen, pixels.word, map.depth_width(), depth.ptr<float>(v), row.depth_mm,
                           row.cell, row.key, out.status.ptr<std::uint8_t>(v),
                           out.bgr.ptr<std::uint8_t>(v));
@@ -173,13 +211,13 @@ void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, con
                        const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
                        RegisteredColor& out) {
   const Sampler colors = sampler;  // a local: see LocatedRow
-  fill_z_buffer(map, cells, depth, colors.addressing(), scratch);
+  fill_z_buffer(map, cells, depth, colors.addressing(), true, scratch);
   const float* const nearest_mm = scratch.nearest_mm.data();
   const int outside = cells.grid().outside;
   const int color_width = map.color_width();
   const int color_height = map.color_height();
   for (int v = 0; v < map.depth_height(); ++v) {
-    const LocatedRow row = scratch.locate(map, cells, depth, v, colors.addressing());
+    const LocatedRow row = scratch.locate_second(map, cells, depth, v, colors.addressing());
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);

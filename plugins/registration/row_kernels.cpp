@@ -410,7 +410,8 @@ void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
 
 }  // namespace
 
-extern const RowKernels kRowKernels{project, locate, keep_nearest, resolve,
-                                    TILTH_KERNEL_LEVEL_NAME};
+// With 16 lanes, locating a row again costs less than keeping it (measured; see Scratch).
+extern const RowKernels kRowKernels{project, locate,       keep_nearest,
+                                    resolve, kLanes >= 16, TILTH_KERNEL_LEVEL_NAME};
 
 }  // namespace tilth::registration::TILTH_KERNEL_LEVEL

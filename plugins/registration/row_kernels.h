@@ -84,6 +84,9 @@ struct RowKernels {
   void (*resolve)(const Visibility& visibility, const PixelWord& pixels, int count,
                   const float* z_mm, const float* color_depth, const int* cell_indices,
                   const int* keys, std::uint8_t* status, std::uint8_t* bgr);
+  // Whether the second pass projects and locates the rows again rather than keeping
+  // every row's locations from the first (see the registration's Scratch).
+  bool locate_again;
   const char* level;  // "x86-64-v4", ...
 };
 
