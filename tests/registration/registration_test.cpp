@@ -255,22 +255,33 @@ std::vector<std::string> levels() {
   return names;
 }
 
-TEST(ProjectiveRegistration, TiltedPlaneMatchesTheReferenceProjection) {
-  const json document = paper_rig();
+// A tilted plane at 518 mm seen by the rig of `document` (in the file `calibration`),
+// registered at every level the CPU runs and held to the reference; returns each level's
+// output for further checks.
+std::vector<std::shared_ptr<const RegisteredColor>> expect_every_level_matches_the_reference(
+    const json& document, const fs::path& calibration, const cv::Mat& color, int min_in_image,
+    const std::string& what) {
   const ref::Rig rig = ref::rig_from(document);
   const auto rays = depth_rays(rig);
   const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
+  std::vector<std::shared_ptr<const RegisteredColor>> outputs;
   for (const std::string& level : levels()) {
     SCOPED_TRACE(level);
-    const auto out = register_color(*make_registration(kPaperRig, "nearest", 10.0, level), depth,
-                                    coordinate_image());
-    const Agreement a = compare(document, kPaperRig, depth, rays, *out, level);
-    // The colour camera sees most of the ToF image: all but a band on the side away
-    // from the baseline.
-    expect_agreement(a, 250000);
-    std::cout << "paper rig, tilted plane, " << level << ": max mapping error "
-              << a.max_mapping_error_px << " px over " << a.in_image << " pixels\n";
+    outputs.push_back(
+        register_color(*make_registration(calibration, "nearest", 10.0, level), depth, color));
+    const Agreement a = compare(document, calibration, depth, rays, *outputs.back(), level);
+    expect_agreement(a, min_in_image);
+    std::cout << what << ", " << level << ": max mapping error " << a.max_mapping_error_px
+              << " px over " << a.in_image << " pixels\n";
   }
+  return outputs;
+}
+
+TEST(ProjectiveRegistration, TiltedPlaneMatchesTheReferenceProjection) {
+  // The colour camera sees most of the ToF image: all but a band on the side away from
+  // the baseline.
+  expect_every_level_matches_the_reference(paper_rig(), kPaperRig, coordinate_image(), 250000,
+                                           "paper rig, tilted plane");
 }
 
 TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProjection) {
@@ -280,18 +291,8 @@ TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProj
   document["depth_camera"]["distortion"] = {-0.12, 0.03, 0.0008, -0.0005, 0.0};
   document["color_camera"]["distortion"] = {-0.2, 0.08, -0.001, 0.0006, -0.01};
   const CalibrationFile file(document);
-  const ref::Rig rig = ref::rig_from(document);
-  const auto rays = depth_rays(rig);
-  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
-  for (const std::string& level : levels()) {
-    SCOPED_TRACE(level);
-    const auto out = register_color(*make_registration(file.path(), "nearest", 10.0, level), depth,
-                                    coordinate_image());
-    const Agreement a = compare(document, file.path(), depth, rays, *out, level);
-    expect_agreement(a, 200000);
-    std::cout << "rotated rig with distortion, " << level << ": max mapping error "
-              << a.max_mapping_error_px << " px over " << a.in_image << " pixels\n";
-  }
+  expect_every_level_matches_the_reference(document, file.path(), coordinate_image(), 200000,
+                                           "rotated rig with distortion");
 }
 
 TEST(ProjectiveRegistration, ImagesOfNoWholeVectorsMatchTheReferenceToTheirLastPixel) {
@@ -306,15 +307,8 @@ TEST(ProjectiveRegistration, ImagesOfNoWholeVectorsMatchTheReferenceToTheirLastP
   document["color_camera"]["width"] = 1279;
   document["color_camera"]["height"] = 1021;
   const CalibrationFile file(document);
-  const ref::Rig rig = ref::rig_from(document);
-  const auto rays = depth_rays(rig);
-  const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
-  for (const std::string& level : levels()) {
-    SCOPED_TRACE(level);
-    const auto out = register_color(*make_registration(file.path(), "nearest", 10.0, level), depth,
-                                    coordinate_image(1279, 1021));
-    const Agreement a = compare(document, file.path(), depth, rays, *out, level);
-    expect_agreement(a, 230000);
+  for (const auto& out : expect_every_level_matches_the_reference(
+           document, file.path(), coordinate_image(1279, 1021), 230000, "613 x 480 px")) {
     // The last column is seen and sampled like the others.
     EXPECT_GT(cv::countNonZero(out->status.col(612) == RegisteredColor::kValid), 400);
   }
