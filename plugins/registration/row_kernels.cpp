@@ -329,19 +329,68 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
   }
 }
 
+// Without gathers and per-lane shifts (below AVX2), building vectors lane by lane costs
+// more than it saves: one pixel at a time, reading its bytes where they are.
+template <WordKind kKind>
+void resolve_pixels(const Visibility& visibility, const PixelWord& pixels, int count,
+                    const float* z_mm, const float* color_depth, const int* cell_indices,
+                    const int* keys, std::uint8_t* status, std::uint8_t* bgr) {
+  // Everything read per pixel in locals: through the byte pointers written, the compiler
+  // must assume any memory changed, and would read the structs' fields again.
+  const float* const nearest_mm = visibility.nearest_mm;
+  const float tolerance_mm = visibility.tolerance_mm;
+  const int outside = visibility.outside;
+  const std::uint8_t valid = visibility.valid, occluded = visibility.occluded;
+  const std::uint8_t no_depth = visibility.no_depth, outside_color = visibility.outside_color;
+  const std::uint8_t* const data = pixels.data;
+  const int key_shift = pixels.key_shift, phase_mask = pixels.phase_mask;
+  const std::ptrdiff_t second_row = pixels.second_row;
+  const int blue = pixels.sites[0], green = pixels.sites[1], green2 = pixels.sites[2];
+  const int red = pixels.sites[3];
+  const auto byte_of = [second_row](int site) -> std::ptrdiff_t {
+    if constexpr (kKind == WordKind::kQuad) return (site & 1) + (site >> 1) * second_row;
+    return site;
+  };
+  for (int u = 0; u < count; ++u) {
+    const int cell = cell_indices[u];
+    const bool visible = color_depth[u] <= nearest_mm[cell] + tolerance_mm;
+    status[u] = visible              ? valid
+                : cell != outside    ? occluded
+                : z_mm[u] != z_mm[u] ? no_depth
+                                     : outside_color;
+    const int key = keys[u];
+    const int phase = key & phase_mask;
+    const std::uint8_t* const p = data + (key >> key_shift);
+    const auto channel = [&](int site) { return int{p[byte_of(site ^ phase)]}; };
+    const int keep = visible ? 0xff : 0;
+    bgr[3 * u] = static_cast<std::uint8_t>(channel(blue) & keep);
+    bgr[3 * u + 1] =
+        static_cast<std::uint8_t>(((channel(green) + channel(green2) + 1) >> 1) & keep);
+    bgr[3 * u + 2] = static_cast<std::uint8_t>(channel(red) & keep);
+  }
+}
+
 void resolve(const Visibility& visibility, const PixelWord& pixels, int count, const float* z_mm,
              const float* color_depth, const int* cell_indices, const int* keys,
              std::uint8_t* status, std::uint8_t* bgr) {
+#if defined(__AVX2__)
+  const auto run = [&]<WordKind kKind>() {
+    resolve_vectors<kKind>(visibility, pixels, count, z_mm, color_depth, cell_indices, keys, status,
+                           bgr);
+  };
+#else
+  const auto run = [&]<WordKind kKind>() {
+    resolve_pixels<kKind>(visibility, pixels, count, z_mm, color_depth, cell_indices, keys, status,
+                          bgr);
+  };
+#endif
   switch (word_kind(pixels)) {
     case WordKind::kBgr:
-      return resolve_vectors<WordKind::kBgr>(visibility, pixels, count, z_mm, color_depth,
-                                             cell_indices, keys, status, bgr);
+      return run.template operator()<WordKind::kBgr>();
     case WordKind::kPixel:
-      return resolve_vectors<WordKind::kPixel>(visibility, pixels, count, z_mm, color_depth,
-                                               cell_indices, keys, status, bgr);
+      return run.template operator()<WordKind::kPixel>();
     case WordKind::kQuad:
-      return resolve_vectors<WordKind::kQuad>(visibility, pixels, count, z_mm, color_depth,
-                                              cell_indices, keys, status, bgr);
+      return run.template operator()<WordKind::kQuad>();
   }
 }
 

@@ -247,15 +247,23 @@ struct StreamRecord {
 
 using ImageCheck = std::function<bool(const Produced&)>;
 
-// Streams for `duration` after the first frame with an image.
+// Streams for `duration` after the first frame with an image, and on to the next frame
+// with an image (for up to 2 s more), so that a pause of the simulator under load at the
+// end does not leave the last status without a frame.
 StreamRecord stream_for(CameraStage& camera, std::chrono::milliseconds duration,
                         const ImageCheck& is_test_image) {
   StreamRecord record;
   Clock::time_point end{};
   std::size_t empty_since_image = 0;
-  while (end == Clock::time_point{} || Clock::now() < end) {
+  bool last_had_image = false;
+  const auto streaming_on = [&] {
+    const auto now = Clock::now();
+    return end == Clock::time_point{} || now < end || (!last_had_image && now < end + 2s);
+  };
+  while (streaming_on()) {
     Produced produced = camera.produce();
     record.last_status = produced.status();
+    last_had_image = produced.has_image();
     if (!produced.has_image()) {
       if (!record.frames.empty()) ++empty_since_image;
       continue;
