@@ -57,18 +57,19 @@ constexpr Vector lanes_of(Lane lane) {
   return lanes_of<Vector>(lane, std::make_index_sequence<kCount>());
 }
 
+// With AVX2 and AVX-512, the second pass is vectors (resolve_vectors); below, one pixel
+// at a time (resolve_pixels).
+#if defined(__AVX2__)
 // base[index] for each lane; the 32-bit words at base + offset. (The masked gathers,
 // from zeros: GCC 12's unmasked ones start from an undefined vector and warn.)
 [[gnu::always_inline]] inline void gather(Floats& values, const float* base, const Ints& index) {
 #if defined(__AVX512F__)
   values = reinterpret_cast<Floats>(_mm512_mask_i32gather_ps(
       _mm512_setzero_ps(), 0xffff, reinterpret_cast<__m512i>(index), base, 4));
-#elif defined(__AVX2__)
+#else
   const __m256 all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   values = reinterpret_cast<Floats>(_mm256_mask_i32gather_ps(
       _mm256_setzero_ps(), base, reinterpret_cast<__m256i>(index), all, 4));
-#else
-  for (int lane = 0; lane < kLanes; ++lane) values[lane] = base[index[lane]];
 #endif
 }
 [[gnu::always_inline]] inline void gather_words(Words& words, const std::uint8_t* base,
@@ -76,18 +77,13 @@ constexpr Vector lanes_of(Lane lane) {
 #if defined(__AVX512F__)
   words = reinterpret_cast<Words>(_mm512_mask_i32gather_epi32(
       _mm512_setzero_si512(), 0xffff, reinterpret_cast<__m512i>(offset), base, 1));
-#elif defined(__AVX2__)
+#else
   words = reinterpret_cast<Words>(
       _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(base),
                                   reinterpret_cast<__m256i>(offset), _mm256_set1_epi32(-1), 1));
-#else
-  for (int lane = 0; lane < kLanes; ++lane) {
-    std::uint32_t word;
-    std::memcpy(&word, base + offset[lane], sizeof word);
-    words[lane] = word;
-  }
 #endif
 }
+#endif
 
 // 1 / x to within 2 float ulps: the vector division takes 8 to 10 cycles a vector where
 // the hardware's estimate, refined by one Newton-Raphson step, takes 3 instructions. x =
@@ -223,16 +219,6 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
 #endif
 }
 
-// The 4 bytes at base + offset for each lane, never reading past base + last + 3: a word
-// is read from at most `last` and shifted down to the bytes wanted. Offsets are >= 0.
-[[gnu::always_inline]] inline void read_words(Words& words, const std::uint8_t* base,
-                                              const Ints& offset, const Ints& last) {
-  const Ints start = offset < last ? offset : last;
-  gather_words(words, base, start);
-  words >>= reinterpret_cast<Words>((offset - start) << 3);
-}
-
-// The colour of each lane's key as blue | green << 8 | red << 16.
 // How a pixel word holds its colour: as blue | green << 8 | red << 16 already (bgr8), as
 // one pixel's bytes in any order, or as a 2x2 quad.
 enum class WordKind { kBgr, kPixel, kQuad };
@@ -244,6 +230,17 @@ WordKind word_kind(const PixelWord& pixels) {
   return pixels.phase_mask == 0 && bgr ? WordKind::kBgr : WordKind::kPixel;
 }
 
+#if defined(__AVX2__)
+// The 4 bytes at base + offset for each lane, never reading past base + last + 3: a word
+// is read from at most `last` and shifted down to the bytes wanted. Offsets are >= 0.
+[[gnu::always_inline]] inline void read_words(Words& words, const std::uint8_t* base,
+                                              const Ints& offset, const Ints& last) {
+  const Ints start = offset < last ? offset : last;
+  gather_words(words, base, start);
+  words >>= reinterpret_cast<Words>((offset - start) << 3);
+}
+
+// The colour of each lane's key as blue | green << 8 | red << 16.
 template <WordKind kKind>
 [[gnu::always_inline]] inline void read_colors(Words& colors, const PixelWord& pixels,
                                                const Ints& key) {
@@ -328,6 +325,8 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
     resolve_lanes(i, lanes, 3 * lanes);
   }
 }
+
+#endif
 
 // Without gathers and per-lane shifts (below AVX2), building vectors lane by lane costs
 // more than it saves: one pixel at a time, reading its bytes where they are.
