@@ -328,8 +328,8 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
 
 #endif
 
-// Without gathers and per-lane shifts (below AVX2), building vectors lane by lane costs
-// more than it saves: one pixel at a time, reading its bytes where they are.
+// Without gathers and per-lane shifts (below AVX2): one pixel at a time, reading its
+// bytes where they are.
 template <WordKind kKind>
 void resolve_pixels(const Visibility& visibility, const PixelWord& pixels, int count,
                     const float* z_mm, const float* color_depth, const int* cell_indices,
