@@ -119,13 +119,15 @@ struct Scratch {
   // The second pass: row `v` as kept, or located again.
   LocatedRow locate_second(const DepthToColor& map, const OcclusionCells& cells,
                            const cv::Mat& depth, int v, const Addressing& addressing) {
-    return keep_rows ? row_at(map, v) : locate(map, cells, depth, v, addressing, false);
+    return keep_rows ? slots(map, v).located() : locate(map, cells, depth, v, addressing, false);
   }
 
  private:
   struct Slots {
     float *u, *v, *depth_mm;
     int *key, *cell;
+
+    LocatedRow located() const { return {u, v, depth_mm, key, cell}; }
   };
 
   LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
@@ -135,12 +137,7 @@ struct Scratch {
     map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
                          map.row_capacity(), row.u, row.v, row.depth_mm,
                          cells_only ? nullptr : row.key, row.cell);
-    return {row.u, row.v, row.depth_mm, row.key, row.cell};
-  }
-
-  LocatedRow row_at(const DepthToColor& map, int v) {
-    const Slots row = slots(map, v);
-    return {row.u, row.v, row.depth_mm, row.key, row.cell};
+    return row.located();
   }
 
   Slots slots(const DepthToColor& map, int v) {
