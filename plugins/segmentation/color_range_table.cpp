@@ -1,6 +1,6 @@
 #include "color_range_table.h"
 
-#include <cstring>
+#include <algorithm>
 
 #include <sys/mman.h>
 
@@ -55,8 +55,9 @@ ColorRangeTable::ColorRangeTable(int conversion, const std::array<int, 3>& lower
 }
 
 void ColorRangeTable::hold_as_runs_if_possible() {
-  std::vector<Run> runs(std::size_t{1} << 16);
-  for (std::size_t green_red = 0; green_red < runs.size(); ++green_red) {
+  constexpr BlueRun kNoBlue = 1;  // first 1, last 0
+  std::vector<BlueRun> runs((std::size_t{1} << 16) + 1, kNoBlue);
+  for (std::size_t green_red = 0; green_red + 1 < runs.size(); ++green_red) {
     const std::uint8_t* blues = in_range_.get() + (green_red << 8);
     int first = 0;
     while (first < 256 && blues[first] == 0) ++first;
@@ -65,9 +66,7 @@ void ColorRangeTable::hold_as_runs_if_possible() {
     for (int b = last + 1; b < 256; ++b) {
       if (blues[b] != 0) return;  // a second run
     }
-    runs[green_red] = first < 256
-                          ? Run{static_cast<std::uint8_t>(first), static_cast<std::uint8_t>(last)}
-                          : Run{1, 0};
+    if (first < 256) runs[green_red] = static_cast<BlueRun>(first | last << 8);
   }
   runs_ = std::move(runs);
   in_range_.reset();
@@ -76,36 +75,26 @@ void ColorRangeTable::hold_as_runs_if_possible() {
 bool ColorRangeTable::contains(std::uint8_t b, std::uint8_t g, std::uint8_t r) const {
   const std::size_t green_red = g | (std::size_t{r} << 8);
   if (runs_.empty()) return in_range_.get()[b | (green_red << 8)] != 0;
-  const Run run = runs_[green_red];
-  return b >= run.first && b <= run.last;
+  const BlueRun run = runs_[green_red];
+  return b >= (run & 0xFF) && b <= (run >> 8);
 }
 
-void ColorRangeTable::classify_row(const std::uint8_t* bgr, int count,
-                                   std::uint8_t* in_range) const {
-  if (count <= 0) return;
-  // Each pixel's three bytes are read as one four-byte word, except the last pixel's,
-  // whose fourth byte may lie beyond the image. Through local pointers, the compiler
-  // need not reload the table after every byte written.
-  if (runs_.empty()) {
-    const std::uint8_t* const table = in_range_.get();
-    for (int x = 0; x + 1 < count; ++x) {
-      std::uint32_t bytes;
-      std::memcpy(&bytes, bgr + 3 * x, sizeof bytes);
-      in_range[x] = table[bytes & 0xFFFFFF];
-    }
-  } else {
-    const Run* const runs = runs_.data();
-    for (int x = 0; x + 1 < count; ++x) {
-      std::uint32_t bytes;
-      std::memcpy(&bytes, bgr + 3 * x, sizeof bytes);
-      const Run run = runs[(bytes >> 8) & 0xFFFF];
-      const int blue = static_cast<int>(bytes & 0xFF);
-      // One sign test instead of two comparisons, which the compiler would branch on.
-      in_range[x] = ((blue - run.first) | (run.last - blue)) >= 0 ? 255 : 0;
-    }
+void ColorRangeTable::classify_row(const ResidueKernels& kernels, const std::uint8_t* bgr,
+                                   int count, std::uint64_t* bits) const {
+  if (!runs_.empty()) {
+    kernels.in_runs(runs_.data(), bgr, count, bits);
+    return;
   }
-  const std::uint8_t* last = bgr + 3 * (count - 1);
-  in_range[count - 1] = contains(last[0], last[1], last[2]) ? 255 : 0;
+  const std::uint8_t* const table = in_range_.get();
+  for (int x = 0; x < count; x += 64) {
+    const int pixels = std::min(64, count - x);
+    std::uint64_t word = 0;
+    for (int i = 0; i < pixels; ++i) {
+      const std::uint8_t* pixel = bgr + 3 * (x + i);
+      word |= std::uint64_t{table[pixel[0] | pixel[1] << 8 | pixel[2] << 16] != 0} << i;
+    }
+    bits[x / 64] = word;
+  }
 }
 
 }  // namespace tilth::segmentation

@@ -14,8 +14,8 @@
 //
 // Per frame the conversion and in-range test are one lookup per pixel in a table of every
 // BGR colour (ColorRangeTable, made when the stage starts with OpenCV's own cvtColor and
-// inRange, so the mask is theirs exactly), and the masks are bits, 64 pixels to a word
-// (BitMask), for the morphology.
+// inRange, so the mask is theirs exactly; looked up with the widest vectors the CPU has),
+// and the masks are bits, 64 pixels to a word (BitMask), for the morphology.
 //
 //   "segment": {"type": "segmentation.color_threshold",
 //               "params": {"color_space": "hsv", "residue_lower": [18, 40, 50],
@@ -32,6 +32,7 @@
 
 #include "bit_mask.h"
 #include "color_range_table.h"
+#include "residue_kernels.h"
 #include "residue_output.h"
 #include "residue_rows.h"
 #include "tilth/error.h"
@@ -124,8 +125,7 @@ ColorRangeTable residue_colors(const Params& params) {
 struct Scratch {
   BitMask residue;    // trusted colour in the residue range; then despeckled and dilated
   BitMask untrusted;  // colour not kValid, or darker than min_value
-  std::vector<std::uint8_t> in_range;  // one row: 255 where the colour is in the range
-  std::vector<std::uint8_t> dark;      // one row: 255 where every channel is below min_value
+  std::vector<std::uint8_t> dark;  // one row: 255 where every channel is below min_value
 };
 
 class ColorThreshold final : public Transform {
@@ -155,13 +155,12 @@ class ColorThreshold final : public Transform {
     const int cols = color.bgr.cols;
     scratch.residue.resize(rows, cols);
     scratch.untrusted.resize(rows, cols);
-    scratch.in_range.resize(static_cast<std::size_t>(cols));
     scratch.dark.resize(kCheckDark ? static_cast<std::size_t>(cols) : 0);
-    std::uint8_t* const in_range = scratch.in_range.data();
     std::uint8_t* const dark = scratch.dark.data();
     for (int y = 0; y < rows; ++y) {
       const auto* bgr = color.bgr.ptr<std::uint8_t>(y);
-      residue_colors_.classify_row(bgr, cols, in_range);
+      std::uint64_t* residue = scratch.residue.row(y);
+      residue_colors_.classify_row(kernels_, bgr, cols, residue);
       if constexpr (kCheckDark) {
         for (int x = 0; x < cols; ++x) {
           const std::uint8_t* pixel = bgr + 3 * x;
@@ -169,7 +168,6 @@ class ColorThreshold final : public Transform {
         }
       }
       const auto* status = color.status.ptr<std::uint8_t>(y);
-      std::uint64_t* residue = scratch.residue.row(y);
       std::uint64_t* untrusted = scratch.untrusted.row(y);
       for (int x = 0; x < cols; x += 64) {
         const int count = std::min(64, cols - x);
@@ -177,12 +175,13 @@ class ColorThreshold final : public Transform {
         const std::uint64_t trusted = valid_status_bits(status + x, count) & ~dark_bits;
         const std::uint64_t pixels =
             count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << count) - 1;
-        residue[x / 64] = marked_bits(in_range + x, count) & trusted;
+        residue[x / 64] &= trusted;
         untrusted[x / 64] = ~trusted & pixels;
       }
     }
   }
 
+  const ResidueKernels& kernels_ = *available_residue_kernels().front();
   const ColorRangeTable residue_colors_;
   const int min_value_;
   ResidueOutput output_;

@@ -139,8 +139,9 @@ void ResidueOutput::emit(Frame& frame, BitMask& residue, const BitMask& unknown,
   residue.erode(speckle_px_, morphology);
   residue.dilate(speckle_px_ + dilation_px_, morphology);
   for (int y = 0; y < depth_mm.rows; ++y) {
-    write_residue_row(unknown.row(y), residue.row(y), depth_mm.ptr<float>(y), depth_mm.cols,
-                      mask->values.ptr<std::uint8_t>(y), soil->mm.ptr<float>(y));
+    kernels_.write_residue_row(unknown.row(y), residue.row(y), depth_mm.ptr<float>(y),
+                               depth_mm.cols, mask->values.ptr<std::uint8_t>(y),
+                               soil->mm.ptr<float>(y));
   }
 
   frame.set_output(kMask, mask);

@@ -10,6 +10,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "bit_mask.h"
+#include "residue_kernels.h"
 #include "tilth/frame.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
@@ -75,6 +76,7 @@ class ResidueOutput {
   void emit(Frame& frame, BitMask& residue, const BitMask& unknown, const cv::Mat& depth_mm);
 
  private:
+  const ResidueKernels& kernels_ = *available_residue_kernels().front();
   const int dilation_px_;
   const int speckle_px_;
   MessagePool<ResidueMask> masks_;

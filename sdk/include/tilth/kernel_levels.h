@@ -1,0 +1,60 @@
+// Kernels compiled once per instruction-set level (tilth_add_kernel_levels in
+// cmake/TilthKernelLevels.cmake), and the choice among them when a stage starts: the
+// widest level this CPU runs, or one named by hand for comparisons. So one build runs on
+// any x86-64 PC and still uses AVX-512 where there is one.
+#pragma once
+
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tilth/error.h"
+
+namespace tilth {
+
+// Whether this CPU runs the instruction-set level `level` ("baseline", "x86-64-v2",
+// "x86-64-v3", "x86-64-v4"); false for names it does not know.
+bool cpu_runs_level(std::string_view level);
+
+// Kernels: a struct of one level's functions with `const char* level`, its name.
+template <class Kernels>
+class KernelLevels {
+ public:
+  // Every level built, widest first.
+  explicit KernelLevels(std::initializer_list<const Kernels*> built) : built_(built) {
+    for (const Kernels* kernels : built_) {
+      if (cpu_runs_level(kernels->level)) runnable_.push_back(kernels);
+    }
+  }
+
+  // "auto" and the names of the levels built, widest first: a parameter's choices.
+  std::vector<std::string> choices() const {
+    std::vector<std::string> names = {"auto"};
+    for (const Kernels* kernels : built_) names.emplace_back(kernels->level);
+    return names;
+  }
+
+  // The levels this CPU runs, widest first.
+  std::span<const Kernels* const> runnable() const { return runnable_; }
+
+  // The level named `level`, or the widest this CPU runs for "auto". Throws naming the
+  // levels this CPU runs when it does not run `level`.
+  const Kernels& pick(std::string_view level) const {
+    if (level == "auto") return *runnable_.front();
+    std::string runs;
+    for (const Kernels* kernels : runnable_) {
+      if (kernels->level == level) return *kernels;
+      runs += std::string(runs.empty() ? "" : ", ") + kernels->level;
+    }
+    throw Error("this CPU does not run instruction set " + std::string(level) + "; it runs " +
+                runs);
+  }
+
+ private:
+  std::vector<const Kernels*> built_;
+  std::vector<const Kernels*> runnable_;
+};
+
+}  // namespace tilth
