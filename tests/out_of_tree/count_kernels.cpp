@@ -1,0 +1,37 @@
+// count_kernels.h at one level: TILTH_KERNEL_LEVEL names the level's namespace.
+#include <cstring>
+
+#include "count_kernels.h"
+
+namespace TILTH_KERNEL_LEVEL {
+namespace {
+
+#if defined(__AVX512F__)
+constexpr int kLanes = 16;
+#elif defined(__AVX__)
+constexpr int kLanes = 8;
+#else
+constexpr int kLanes = 4;
+#endif
+using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
+using Ints = int __attribute__((vector_size(kLanes * sizeof(int))));
+
+int count_above(const float* values, int count, float threshold) {
+  Ints counts{};
+  int i = 0;
+  for (; i + kLanes <= count; i += kLanes) {
+    Floats v;
+    std::memcpy(&v, values + i, sizeof v);
+    counts -= v > threshold;  // true is -1
+  }
+  int total = 0;
+  for (int lane = 0; lane < kLanes; ++lane) total += counts[lane];
+  for (; i < count; ++i) total += values[i] > threshold ? 1 : 0;
+  return total;
+}
+
+}  // namespace
+
+extern const CountKernels kCountKernels{count_above, TILTH_KERNEL_LEVEL_NAME};
+
+}  // namespace TILTH_KERNEL_LEVEL
