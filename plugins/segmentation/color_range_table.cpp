@@ -1,6 +1,6 @@
 #include "color_range_table.h"
 
-#include <algorithm>
+#include <cstring>
 
 #include <sys/mman.h>
 
@@ -15,12 +15,15 @@ namespace {
 constexpr std::size_t kColors = std::size_t{1} << 24;
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 
-// Asked for before the first write, which is when the pages are made. Where transparent
-// huge pages are off, the advice is ignored and the table has ordinary pages.
+// A byte per colour and 3 more (ResidueKernels::in_table reads each entry as a word), in
+// whole huge pages. Asked for before the first write, which is when the pages are made.
+// Where transparent huge pages are off, the advice is ignored and the table has
+// ordinary pages.
 std::uint8_t* allocate_on_huge_pages() {
-  void* bytes = std::aligned_alloc(kHugePage, kColors);
+  void* bytes = std::aligned_alloc(kHugePage, kColors + kHugePage);
   if (bytes == nullptr) throw std::bad_alloc();
   madvise(bytes, kColors, MADV_HUGEPAGE);
+  std::memset(static_cast<std::uint8_t*>(bytes) + kColors, 0, 3);
   return static_cast<std::uint8_t*>(bytes);
 }
 
@@ -81,19 +84,10 @@ bool ColorRangeTable::contains(std::uint8_t b, std::uint8_t g, std::uint8_t r) c
 
 void ColorRangeTable::classify_row(const ResidueKernels& kernels, const std::uint8_t* bgr,
                                    int count, std::uint64_t* bits) const {
-  if (!runs_.empty()) {
+  if (runs_.empty()) {
+    kernels.in_table(in_range_.get(), bgr, count, bits);
+  } else {
     kernels.in_runs(runs_.data(), bgr, count, bits);
-    return;
-  }
-  const std::uint8_t* const table = in_range_.get();
-  for (int x = 0; x < count; x += 64) {
-    const int pixels = std::min(64, count - x);
-    std::uint64_t word = 0;
-    for (int i = 0; i < pixels; ++i) {
-      const std::uint8_t* pixel = bgr + 3 * (x + i);
-      word |= std::uint64_t{table[pixel[0] | pixel[1] << 8 | pixel[2] << 16] != 0} << i;
-    }
-    bits[x / 64] = word;
   }
 }
 

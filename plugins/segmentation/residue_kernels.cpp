@@ -46,34 +46,47 @@ constexpr Ints kLaneBit = lane_bits(std::make_index_sequence<kLanes>());
 
 #if defined(__AVX2__)
 // With gathers: a vector of pixels at a time. Each pixel's 3 bytes are spread to a word
-// b | g << 8 | r << 16 (12 bytes, 4 pixels, to each 128-bit lane, then a byte shuffle
-// within the lanes), and g | r << 8 is the index of its run.
+// b | g << 8 | r << 16, the colour's index in a table of every colour; g | r << 8 is the
+// index of its run. (12 bytes, 4 pixels, go to each 128-bit lane, then a byte shuffle
+// spreads them within the lane.)
 [[gnu::always_inline]] inline __m128i spread_in_lane() {
   return _mm_setr_epi8(0, 1, 2, -1, 3, 4, 5, -1, 6, 7, 8, -1, 9, 10, 11, -1);
 }
 
-// The in-range bits of `lanes` <= kLanes pixels from bgr on, reading no byte beyond them.
-[[gnu::always_inline]] inline std::uint64_t in_runs_vector(const BlueRun* runs,
-                                                           const std::uint8_t* bgr, int lanes) {
 #if defined(__AVX512BW__)
+using Words = __m512i;
+
+// The words of `lanes` <= kLanes pixels from bgr on, reading no byte beyond them. (The
+// masked forms, from zeros: GCC 12's unmasked ones start from an undefined vector and
+// warn.)
+[[gnu::always_inline]] inline Words pixel_words(const std::uint8_t* bgr, int lanes) {
   const __mmask64 bytes = (std::uint64_t{1} << (3 * lanes)) - 1;
   const __m512i raw = _mm512_maskz_loadu_epi8(bytes, bgr);
-  // (The masked forms, from zeros: GCC 12's unmasked ones start from an undefined vector
-  // and warn.)
   const __m512i spread = _mm512_maskz_permutexvar_epi32(
       0xffff, _mm512_setr_epi32(0, 1, 2, 0, 3, 4, 5, 0, 6, 7, 8, 0, 9, 10, 11, 0), raw);
-  const __m512i words =
-      _mm512_shuffle_epi8(spread, _mm512_maskz_broadcast_i32x4(0xffff, spread_in_lane()));
+  return _mm512_shuffle_epi8(spread, _mm512_maskz_broadcast_i32x4(0xffff, spread_in_lane()));
+}
+
+[[gnu::always_inline]] inline std::uint64_t in_runs_lanes(const BlueRun* runs, const Words& words) {
   const __m512i run = _mm512_mask_i32gather_epi32(
       _mm512_setzero_si512(), 0xffff, _mm512_maskz_srli_epi32(0xffff, words, 8), runs, 2);
   const __m512i byte = _mm512_set1_epi32(0xff);
   const __m512i blue = _mm512_and_si512(words, byte);
   const __m512i first = _mm512_and_si512(run, byte);
   const __m512i last = _mm512_and_si512(_mm512_maskz_srli_epi32(0xffff, run, 8), byte);
-  const __mmask16 in =
-      _mm512_mask_cmple_epu32_mask(_mm512_cmple_epu32_mask(first, blue), blue, last);
-  return in & ((std::uint64_t{1} << lanes) - 1);
+  return _mm512_mask_cmple_epu32_mask(_mm512_cmple_epu32_mask(first, blue), blue, last);
+}
+
+[[gnu::always_inline]] inline std::uint64_t in_table_lanes(const std::uint8_t* table,
+                                                           const Words& words) {
+  const __m512i entry =
+      _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xffff, words, table, 1);
+  return _mm512_test_epi32_mask(entry, _mm512_set1_epi32(0xff));
+}
 #else
+using Words = __m256i;
+
+[[gnu::always_inline]] inline Words pixel_words(const std::uint8_t* bgr, int lanes) {
   __m256i raw;
   if (lanes == kLanes) {  // 24 bytes: 6 words
     raw = _mm256_maskload_epi32(reinterpret_cast<const int*>(bgr),
@@ -85,7 +98,10 @@ constexpr Ints kLaneBit = lane_bits(std::make_index_sequence<kLanes>());
   }
   const __m256i spread =
       _mm256_permutevar8x32_epi32(raw, _mm256_setr_epi32(0, 1, 2, 0, 3, 4, 5, 0));
-  const __m256i words = _mm256_shuffle_epi8(spread, _mm256_broadcastsi128_si256(spread_in_lane()));
+  return _mm256_shuffle_epi8(spread, _mm256_broadcastsi128_si256(spread_in_lane()));
+}
+
+[[gnu::always_inline]] inline std::uint64_t in_runs_lanes(const BlueRun* runs, const Words& words) {
   const __m256i run =
       _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(runs),
                                   _mm256_srli_epi32(words, 8), _mm256_set1_epi32(-1), 2);
@@ -95,36 +111,74 @@ constexpr Ints kLaneBit = lane_bits(std::make_index_sequence<kLanes>());
   const __m256i last = _mm256_and_si256(_mm256_srli_epi32(run, 8), byte);
   const __m256i out =
       _mm256_or_si256(_mm256_cmpgt_epi32(first, blue), _mm256_cmpgt_epi32(blue, last));
-  const auto in = static_cast<unsigned>(~_mm256_movemask_ps(_mm256_castsi256_ps(out)));
-  return in & ((1u << lanes) - 1);
-#endif
+  return static_cast<std::uint8_t>(~_mm256_movemask_ps(_mm256_castsi256_ps(out)));
 }
-#else
-// Without gathers: a pixel at a time.
-[[gnu::always_inline]] inline bool in_run(const BlueRun* runs, const std::uint8_t* pixel) {
-  const BlueRun run = runs[pixel[1] | pixel[2] << 8];
-  const int blue = pixel[0];
-  return blue >= (run & 0xff) && blue <= (run >> 8);
+
+[[gnu::always_inline]] inline std::uint64_t in_table_lanes(const std::uint8_t* table,
+                                                           const Words& words) {
+  const __m256i entry = _mm256_mask_i32gather_epi32(
+      _mm256_setzero_si256(), reinterpret_cast<const int*>(table), words, _mm256_set1_epi32(-1), 1);
+  const __m256i out =
+      _mm256_cmpeq_epi32(_mm256_and_si256(entry, _mm256_set1_epi32(0xff)), _mm256_setzero_si256());
+  return static_cast<std::uint8_t>(~_mm256_movemask_ps(_mm256_castsi256_ps(out)));
 }
 #endif
 
-void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
+// bits for `count` pixels from bgr on; in_lanes(words) gives a vector's in-range bits.
+template <class InLanes>
+[[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
+                                            InLanes in_lanes) {
   for (int x = 0; x < count; x += 64) {
     const int pixels = count - x < 64 ? count - x : 64;
     std::uint64_t word = 0;
-#if defined(__AVX2__)
     for (int i = 0; i < pixels; i += kLanes) {
       const int lanes = pixels - i < kLanes ? pixels - i : kLanes;
-      word |= in_runs_vector(runs, bgr + 3 * (x + i), lanes) << i;
+      const std::uint64_t in = in_lanes(pixel_words(bgr + 3 * (x + i), lanes));
+      word |= (in & ((std::uint64_t{1} << lanes) - 1)) << i;
     }
-#else
-    for (int i = 0; i < pixels; ++i) {
-      word |= std::uint64_t{in_run(runs, bgr + 3 * (x + i))} << i;
-    }
-#endif
     bits[x / 64] = word;
   }
 }
+
+void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
+  classify(
+      bgr, count, bits, [runs](const Words& words) __attribute__((always_inline)) {
+        return in_runs_lanes(runs, words);
+      });
+}
+
+void in_table(const std::uint8_t* table, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
+  classify(
+      bgr, count, bits, [table](const Words& words) __attribute__((always_inline)) {
+        return in_table_lanes(table, words);
+      });
+}
+#else
+// Without gathers: a pixel at a time; in(pixel) says whether it is in range.
+template <class In>
+[[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
+                                            In in) {
+  for (int x = 0; x < count; x += 64) {
+    const int pixels = count - x < 64 ? count - x : 64;
+    std::uint64_t word = 0;
+    for (int i = 0; i < pixels; ++i) word |= std::uint64_t{in(bgr + 3 * (x + i))} << i;
+    bits[x / 64] = word;
+  }
+}
+
+void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
+  classify(bgr, count, bits, [runs](const std::uint8_t* pixel) {
+    const BlueRun run = runs[pixel[1] | pixel[2] << 8];
+    return pixel[0] >= (run & 0xff) && pixel[0] <= (run >> 8);
+  });
+}
+
+void in_table(const std::uint8_t* table, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
+  classify(bgr, count, bits, [table](const std::uint8_t* pixel) {
+    return table[pixel[0] | pixel[1] << 8 | pixel[2] << 16] != 0;
+  });
+}
+#endif
 
 void write_residue_row(const std::uint64_t* unknown, const std::uint64_t* residue,
                        const float* depth_mm, int cols, std::uint8_t* mask, float* soil_mm) {
@@ -160,6 +214,7 @@ void write_residue_row(const std::uint64_t* unknown, const std::uint64_t* residu
 
 }  // namespace
 
-extern const ResidueKernels kResidueKernels{in_runs, write_residue_row, TILTH_KERNEL_LEVEL_NAME};
+extern const ResidueKernels kResidueKernels{in_runs, in_table, write_residue_row,
+                                            TILTH_KERNEL_LEVEL_NAME};
 
 }  // namespace tilth::segmentation::TILTH_KERNEL_LEVEL

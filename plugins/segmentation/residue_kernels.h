@@ -1,7 +1,7 @@
 // The residue segmentation's per-row loops that gain from wide vectors: the in-range
-// test of a colour box held as runs of blues (ColorRangeTable), and the rows of the
-// outputs. residue_kernels.cpp is compiled once per instruction-set level
-// (tilth/kernel_levels.h); the stages use the widest the CPU runs.
+// test of a colour box (ColorRangeTable), and the rows of the outputs. residue_kernels.cpp is
+// compiled once per instruction-set level (tilth/kernel_levels.h); the stages use the widest the
+// CPU runs.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +17,10 @@ struct ResidueKernels {
   // of `runs`, indexed by green + 256 * red, which holds one entry more than that, so
   // that each run can be read as a word. Bits from `count` on in the last word are 0.
   void (*in_runs)(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits);
+  // The same for a box held as a byte per colour b | g << 8 | r << 16, not 0 inside; the
+  // table holds 3 bytes more, so that each entry can be read as a word.
+  void (*in_table)(const std::uint8_t* table, const std::uint8_t* bgr, int count,
+                   std::uint64_t* bits);
   // One row of the outputs: a pixel is ResidueMask::kUnknown where its `unknown` bit is
   // set or its depth is NaN, otherwise kResidue where its `residue` bit is set, otherwise
   // kSoil; its soil depth is depth_mm where the mask says kSoil, NaN elsewhere.
