@@ -12,23 +12,14 @@
 #endif
 
 #include "residue_kernels.h"
+#include "tilth/kernel_level.h"
 #include "tilth/messages/residue_mask.h"
-
-#ifndef TILTH_KERNEL_LEVEL
-#error "compile with TILTH_KERNEL_LEVEL (the namespace) and TILTH_KERNEL_LEVEL_NAME"
-#endif
 
 namespace tilth::segmentation::TILTH_KERNEL_LEVEL {
 namespace {
 
 // Floats and ints in one register of the level, GCC vector extensions.
-#if defined(__AVX512F__)
-constexpr int kLanes = 16;
-#elif defined(__AVX__)
-constexpr int kLanes = 8;
-#else
-constexpr int kLanes = 4;  // SSE2, SSE4.2, NEON
-#endif
+constexpr int kLanes = kKernelLanes;
 static_assert(64 % kLanes == 0, "a vector's pixels lie in one mask word");
 
 using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));

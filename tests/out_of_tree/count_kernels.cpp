@@ -2,17 +2,12 @@
 #include <cstring>
 
 #include "count_kernels.h"
+#include "tilth/kernel_level.h"
 
 namespace TILTH_KERNEL_LEVEL {
 namespace {
 
-#if defined(__AVX512F__)
-constexpr int kLanes = 16;
-#elif defined(__AVX__)
-constexpr int kLanes = 8;
-#else
-constexpr int kLanes = 4;
-#endif
+constexpr int kLanes = tilth::kKernelLanes;
 using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
 using Ints = int __attribute__((vector_size(kLanes * sizeof(int))));
 
