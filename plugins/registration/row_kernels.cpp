@@ -41,7 +41,9 @@ using WordBytes = std::uint8_t __attribute__((vector_size(kLanes * sizeof(std::u
 
 // Vectors go by reference: returned by value they would be passed differently per level.
 void load(Floats& v, const float* values) { std::memcpy(&v, values, sizeof v); }
+#if defined(__AVX2__)  // below AVX2 the vectors read are floats only
 void load(Ints& v, const int* values) { std::memcpy(&v, values, sizeof v); }
+#endif
 void store(float* values, const Floats& v) { std::memcpy(values, &v, sizeof v); }
 void store(int* values, const Ints& v) { std::memcpy(values, &v, sizeof v); }
 
@@ -177,19 +179,16 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
   ys == nullptr ? run.template operator()<true>() : run.template operator()<false>();
 }
 
+#if defined(__AVX512F__)
 // The nearest point of each cell: nearest_mm[cell] = min(nearest_mm[cell], depth) for
 // each point. Neighbouring points mostly share a cell, and a store followed by a load of
 // the same cell waits for the store. So each run of lanes with one cell first takes its
 // minimum in the vector (the lanes before each lane, 1, 2, 4, ... back, that share its
-// cell), and its last lane alone writes the cell. The writes are listed in `written` and
-// `mins` (room for kLanes) and applied a chunk later, because a load of a lane just
-// stored from a vector would wait for the store. With AVX-512 the list holds the writes
-// alone; otherwise the lanes that do not write list spare cells of their own. Returns
-// the length of the list.
+// cell), and its last lane alone writes the cell. The writes are compressed into
+// `written` and `mins` (room for kLanes) and applied a chunk later, because a load of a
+// lane just stored from a vector would wait for the store. Returns the number of writes.
 [[gnu::always_inline]] inline int run_minimums(const Ints& cell, const Floats& depth,
-                                               const Ints& outside,
-                                               [[maybe_unused]] const Ints& spares, int* written,
-                                               float* mins) {
+                                               const Ints& outside, int* written, float* mins) {
   Floats run_min = depth;
   const auto step_back = [&]<int kStep>() {
     constexpr Ints kBack =
@@ -200,24 +199,19 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
   };
   step_back.template operator()<1>();
   step_back.template operator()<2>();
-  if constexpr (kLanes > 4) step_back.template operator()<4>();
-  if constexpr (kLanes > 8) step_back.template operator()<8>();
+  step_back.template operator()<4>();
+  step_back.template operator()<8>();
   constexpr Ints kNext =
       lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? lane + 1 : lane; });
   constexpr Ints kLast = lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? 0 : -1; });
   // The outside cell's points have NaN depth: no write changes it.
   const Ints writes = ((__builtin_shuffle(cell, kNext) != cell) | kLast) & (cell != outside);
-#if defined(__AVX512F__)
   const __mmask16 lanes = _mm512_movepi32_mask(reinterpret_cast<__m512i>(writes));
   _mm512_storeu_si512(written, _mm512_maskz_compress_epi32(lanes, reinterpret_cast<__m512i>(cell)));
   _mm512_storeu_ps(mins, _mm512_maskz_compress_ps(lanes, reinterpret_cast<__m512>(run_min)));
   return __builtin_popcount(lanes);
-#else
-  store(written, writes ? cell : spares);
-  store(mins, run_min);
-  return kLanes;
-#endif
 }
+#endif
 
 // How a pixel word holds its colour: as blue | green << 8 | red << 16 already (bgr8), as
 // one pixel's bytes in any order, or as a 2x2 quad.
@@ -329,7 +323,7 @@ void resolve_vectors(const Visibility& visibility, const PixelWord& pixels, int 
 #endif
 
 // Without gathers and per-lane shifts (below AVX2): one pixel at a time, reading its
-// bytes where they are.
+// bytes where a table per channel and phase of the key places them.
 template <WordKind kKind>
 void resolve_pixels(const Visibility& visibility, const PixelWord& pixels, int count,
                     const float* z_mm, const float* color_depth, const int* cell_indices,
@@ -343,29 +337,46 @@ void resolve_pixels(const Visibility& visibility, const PixelWord& pixels, int c
   const std::uint8_t no_depth = visibility.no_depth, outside_color = visibility.outside_color;
   const std::uint8_t* const data = pixels.data;
   const int key_shift = pixels.key_shift, phase_mask = pixels.phase_mask;
-  const std::ptrdiff_t second_row = pixels.second_row;
-  const int blue = pixels.sites[0], green = pixels.sites[1], green2 = pixels.sites[2];
-  const int red = pixels.sites[3];
-  const auto byte_of = [second_row](int site) -> std::ptrdiff_t {
-    if constexpr (kKind == WordKind::kQuad) return (site & 1) + (site >> 1) * second_row;
-    return site;
+  // Per channel (blue, the greens, red) and phase (at most 3), its byte from the key's
+  // first: channel-major, so that a phase indexes each channel's offsets directly.
+  std::ptrdiff_t offsets[4][4];
+  for (int channel = 0; channel < 4; ++channel) {
+    for (int phase = 0; phase <= phase_mask; ++phase) {
+      const int site = pixels.sites[static_cast<std::size_t>(channel)] ^ phase;
+      offsets[channel][phase] =
+          kKind == WordKind::kQuad ? (site & 1) + (site >> 1) * pixels.second_row : site;
+    }
+  }
+  // The colour at `key` as blue | green << 8 | red << 16.
+  const auto color_at = [&](int key) __attribute__((always_inline))->std::uint32_t {
+    const std::uint8_t* const p = data + (key >> key_shift);
+    if constexpr (kKind == WordKind::kBgr) {
+      return p[0] | p[1] << 8 | p[2] << 16;
+    } else {
+      const int phase = key & phase_mask;
+      const auto channel = [&](int channel) { return int{p[offsets[channel][phase]]}; };
+      return channel(0) | ((channel(1) + channel(2) + 1) >> 1) << 8 | channel(3) << 16;
+    }
   };
-  for (int u = 0; u < count; ++u) {
+  // The status of pixel u, and its colour if valid, else black.
+  const auto resolve_pixel = [&](int u) __attribute__((always_inline)) {
     const int cell = cell_indices[u];
     const bool visible = color_depth[u] <= nearest_mm[cell] + tolerance_mm;
     status[u] = visible              ? valid
                 : cell != outside    ? occluded
                 : z_mm[u] != z_mm[u] ? no_depth
                                      : outside_color;
-    const int key = keys[u];
-    const int phase = key & phase_mask;
-    const std::uint8_t* const p = data + (key >> key_shift);
-    const auto channel = [&](int site) { return int{p[byte_of(site ^ phase)]}; };
-    const int keep = visible ? 0xff : 0;
-    bgr[3 * u] = static_cast<std::uint8_t>(channel(blue) & keep);
-    bgr[3 * u + 1] =
-        static_cast<std::uint8_t>(((channel(green) + channel(green2) + 1) >> 1) & keep);
-    bgr[3 * u + 2] = static_cast<std::uint8_t>(channel(red) & keep);
+    return color_at(keys[u]) & (visible ? 0xffffffu : 0u);
+  };
+  // While a pixel follows, a colour is written as a whole word: its last byte is junk
+  // that the next pixel overwrites.
+  for (int u = 0; u + 1 < count; ++u) {
+    const std::uint32_t color = resolve_pixel(u);
+    std::memcpy(bgr + 3 * u, &color, 4);
+  }
+  if (count > 0) {
+    const std::uint32_t color = resolve_pixel(count - 1);
+    std::memcpy(bgr + 3 * (count - 1), &color, 3);
   }
 }
 
@@ -431,10 +442,10 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
   }
 }
 
+#if defined(__AVX512F__)
 void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
                   const int* cell_indices, float* nearest_mm) {
   const Ints outside = Ints{} + cells.outside;
-  const Ints spares = lanes_of<Ints>([&](int lane) { return cells.outside + 1 + lane; });
   constexpr int kChunk = 256;
   static_assert(kChunk % kRowLanes == 0);
   int written[kChunk + kLanes];
@@ -447,7 +458,7 @@ void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
       Ints cell;
       load(depth, color_depth + i);
       load(cell, cell_indices + i);
-      listed += run_minimums(cell, depth, outside, spares, written + listed, mins + listed);
+      listed += run_minimums(cell, depth, outside, written + listed, mins + listed);
     }
     for (int i = 0; i < listed; ++i) {
       float& nearest = nearest_mm[written[i]];
@@ -455,6 +466,17 @@ void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
     }
   }
 }
+#else
+// Below AVX-512 one point at a time: without the compress, listing a vector's runs costs
+// more than waiting for a neighbour's store (measured). NaN depth leaves a cell as it was.
+void keep_nearest(const CellGrid&, int count, const float* color_depth, const int* cell_indices,
+                  float* nearest_mm) {
+  for (int i = 0; i < count; ++i) {
+    float& nearest = nearest_mm[cell_indices[i]];
+    nearest = color_depth[i] < nearest ? color_depth[i] : nearest;
+  }
+}
+#endif
 
 }  // namespace
 

@@ -38,17 +38,14 @@ struct ProjectionModel {
   float edge_margin_px;
 };
 
-// The z-buffer's cells: squares of `size` colour pixels, `columns` to a row; one more
-// cell, `outside`, for the points the colour image does not show; and after it
-// kSpareCells that the kernels write to instead of a cell where that saves a wait.
+// The z-buffer's cells: squares of `size` colour pixels, `columns` to a row, and one more
+// cell, `outside`, for the points the colour image does not show.
 struct CellGrid {
-  static constexpr int kSpareCells = kRowLanes;
-
   int size;
   int columns;
   int outside;
 
-  int count() const { return outside + 1 + kSpareCells; }
+  int count() const { return outside + 1; }
 };
 
 // What decides a located point's status, and the status codes (RegisteredColor's).

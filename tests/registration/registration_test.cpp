@@ -634,6 +634,31 @@ TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
   }
 }
 
+TEST(ProjectiveRegistration, RgbAndMonoInputReadTheBgrPixelAtEveryLevel) {
+  // Nearest sampling reads an rgb8 or mono8 image's pixel where it reads the bgr8 one,
+  // at each level's way of reading a pixel's bytes.
+  cv::Mat noise(1024, 1280, CV_8UC3);
+  cv::randu(noise, 0, 256);
+  cv::Mat rgb, blue;
+  cv::cvtColor(noise, rgb, cv::COLOR_BGR2RGB);
+  cv::extractChannel(noise, blue, 0);
+  const ref::Rig rig = ref::rig_from(paper_rig());
+  const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
+  for (const std::string& level : levels()) {
+    SCOPED_TRACE(level);
+    const auto stage = make_registration(kPaperRig, "nearest", 10.0, level);
+    const auto bgr = register_color(*stage, depth, noise);
+    ASSERT_GT(cv::countNonZero(bgr->status == RegisteredColor::kValid), 250000);
+    const auto from_rgb = register_color(*stage, depth, rgb, PixelFormat::kRgb8);
+    EXPECT_EQ(cv::norm(from_rgb->bgr, bgr->bgr, cv::NORM_INF), 0);
+    const auto from_mono = register_color(*stage, depth, blue, PixelFormat::kMono8);
+    cv::Mat registered_blue, expected_gray;
+    cv::extractChannel(bgr->bgr, registered_blue, 0);
+    cv::merge(std::vector<cv::Mat>(3, registered_blue), expected_gray);
+    EXPECT_EQ(cv::norm(from_mono->bgr, expected_gray, cv::NORM_INF), 0);
+  }
+}
+
 TEST(ProjectiveRegistration, BilinearSamplingFollowsARampBetweenPixels) {
   // B = 4 (u - 600) and G = 4 (v - 400) in a window: bilinear sampling reproduces the
   // ramp at the projected position to within rounding (0.5 level) and 1/256 weights
