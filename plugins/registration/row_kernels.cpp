@@ -14,23 +14,14 @@
 
 #include "lens_model.h"
 #include "row_kernels.h"
-
-#ifndef TILTH_KERNEL_LEVEL
-#error "compile with TILTH_KERNEL_LEVEL (the namespace) and TILTH_KERNEL_LEVEL_NAME"
-#endif
+#include "tilth/kernel_level.h"
 
 namespace tilth::registration::TILTH_KERNEL_LEVEL {
 namespace {
 
 // Floats and ints in one register of the level, GCC vector extensions. Vectors wider
 // than the registers would be split up, and some operations one lane at a time.
-#if defined(__AVX512F__)
-constexpr int kLanes = 16;
-#elif defined(__AVX__)
-constexpr int kLanes = 8;
-#else
-constexpr int kLanes = 4;  // SSE2, SSE4.2, NEON
-#endif
+constexpr int kLanes = kKernelLanes;
 static_assert(kRowLanes % kLanes == 0, "rows are whole vectors of every level");
 
 using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
