@@ -21,6 +21,7 @@
 
 #include "estimators.h"
 #include "rank_selection.h"
+#include "soil_kernels.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
@@ -104,57 +105,20 @@ class GroundDistanceEstimator final : public Transform {
     float highest;
   };
 
-  // Four pixels at a time: soil and residue come in patches, so four depths are mostly
-  // all finite or all not. Mixed groups are stored without a branch per pixel: every
-  // depth is stored, and the count moves on past the finite ones. The range comes with
-  // them, the other lanes held at the far end.
-  static SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
-                                   std::vector<float>& depths) {
-    // One slot more for the last store. Never shrunk, so no frame after the first
-    // allocates or clears it.
-    const auto slots = static_cast<std::size_t>(roi.area()) + 1;
+  // The region's finite depths, a row at a time with the widest vectors the CPU runs.
+  SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
+                            std::vector<float>& depths) const {
+    // Room for the kernel's whole-vector stores past the last depth. Never shrunk, so no
+    // frame after the first allocates or clears it.
+    const auto slots = static_cast<std::size_t>(roi.area()) + kSlack;
     if (depths.size() < slots) depths.resize(slots);
-    float* const out = depths.data();
-    std::size_t count = 0;
     constexpr float kLargest = std::numeric_limits<float>::max();
-    float lowest = kLargest;
-    float highest = -kLargest;
-    const auto collect = [&](const float* depth, int first, int end) {
-      for (int col = first; col < end; ++col) {
-        out[count] = depth[col];
-        count += std::isfinite(depth[col]) ? 1 : 0;
-      }
-    };
-    const cv::v_float32x4 largest = cv::v_setall_f32(kLargest);
-    const cv::v_float32x4 smallest = cv::v_setall_f32(-kLargest);
-    cv::v_float32x4 low = largest;
-    cv::v_float32x4 high = smallest;
+    CollectedDepths collected{depths.data(), kLargest, -kLargest};
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
-      const float* depth = depth_mm.ptr<float>(row);
-      int col = roi.x;
-      for (; col + 4 <= roi.x + roi.width; col += 4) {
-        const cv::v_float32x4 four = cv::v_load(depth + col);
-        const cv::v_float32x4 finite_lanes = cv::v_abs(four) <= largest;  // NaN, inf: false
-        low = cv::v_min(low, cv::v_select(finite_lanes, four, largest));
-        high = cv::v_max(high, cv::v_select(finite_lanes, four, smallest));
-        const int finite = cv::v_signmask(finite_lanes);
-        if (finite == 0xF) {
-          cv::v_store(out + count, four);
-          count += 4;
-        } else if (finite != 0) {
-          collect(depth, col, col + 4);
-        }
-      }
-      collect(depth, col, roi.x + roi.width);
-      for (; col < roi.x + roi.width; ++col) {
-        if (!std::isfinite(depth[col])) continue;
-        lowest = std::min(lowest, depth[col]);
-        highest = std::max(highest, depth[col]);
-      }
+      collected = kernels_.collect_finite(depth_mm.ptr<float>(row) + roi.x, roi.width, collected);
     }
-    return {{out, count},
-            std::min(lowest, cv::v_reduce_min(low)),
-            std::max(highest, cv::v_reduce_max(high))};
+    const auto count = static_cast<std::size_t>(collected.end - depths.data());
+    return {{depths.data(), count}, collected.lowest, collected.highest};
   }
 
   // The trimmed mean, the median and the spread from one histogram of the depths and one
@@ -181,6 +145,7 @@ class GroundDistanceEstimator final : public Transform {
     out.confidence = confidence(out.soil_fraction, out.spread_mm);
   }
 
+  const SoilKernels& kernels_ = *available_soil_kernels().front();
   const RegionOfInterest region_;
   const Statistic statistic_;
   const double trim_fraction_;
