@@ -58,7 +58,7 @@ using Words = __m512i;
   return _mm512_shuffle_epi8(spread, _mm512_maskz_broadcast_i32x4(0xffff, spread_in_lane()));
 }
 
-[[gnu::always_inline]] inline std::uint64_t in_runs_lanes(const BlueRun* runs, const Words& words) {
+[[gnu::always_inline]] inline std::uint64_t runs_contain(const BlueRun* runs, const Words& words) {
   const __m512i run = _mm512_mask_i32gather_epi32(
       _mm512_setzero_si512(), 0xffff, _mm512_maskz_srli_epi32(0xffff, words, 8), runs, 2);
   const __m512i byte = _mm512_set1_epi32(0xff);
@@ -68,7 +68,7 @@ using Words = __m512i;
   return _mm512_mask_cmple_epu32_mask(_mm512_cmple_epu32_mask(first, blue), blue, last);
 }
 
-[[gnu::always_inline]] inline std::uint64_t in_table_lanes(const std::uint8_t* table,
+[[gnu::always_inline]] inline std::uint64_t table_contains(const std::uint8_t* table,
                                                            const Words& words) {
   const __m512i entry =
       _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xffff, words, table, 1);
@@ -92,7 +92,7 @@ using Words = __m256i;
   return _mm256_shuffle_epi8(spread, _mm256_broadcastsi128_si256(spread_in_lane()));
 }
 
-[[gnu::always_inline]] inline std::uint64_t in_runs_lanes(const BlueRun* runs, const Words& words) {
+[[gnu::always_inline]] inline std::uint64_t runs_contain(const BlueRun* runs, const Words& words) {
   const __m256i run =
       _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(runs),
                                   _mm256_srli_epi32(words, 8), _mm256_set1_epi32(-1), 2);
@@ -105,7 +105,7 @@ using Words = __m256i;
   return static_cast<std::uint8_t>(~_mm256_movemask_ps(_mm256_castsi256_ps(out)));
 }
 
-[[gnu::always_inline]] inline std::uint64_t in_table_lanes(const std::uint8_t* table,
+[[gnu::always_inline]] inline std::uint64_t table_contains(const std::uint8_t* table,
                                                            const Words& words) {
   const __m256i entry = _mm256_mask_i32gather_epi32(
       _mm256_setzero_si256(), reinterpret_cast<const int*>(table), words, _mm256_set1_epi32(-1), 1);
@@ -115,35 +115,22 @@ using Words = __m256i;
 }
 #endif
 
-// bits for `count` pixels from bgr on; in_lanes(words) gives a vector's in-range bits.
-template <class InLanes>
+// bits for `count` pixels from bgr on; in(words) gives a vector's in-range bits.
+template <class In>
 [[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
-                                            InLanes in_lanes) {
+                                            In in) {
   for (int x = 0; x < count; x += 64) {
     const int pixels = count - x < 64 ? count - x : 64;
     std::uint64_t word = 0;
     for (int i = 0; i < pixels; i += kLanes) {
       const int lanes = pixels - i < kLanes ? pixels - i : kLanes;
-      const std::uint64_t in = in_lanes(pixel_words(bgr + 3 * (x + i), lanes));
-      word |= (in & ((std::uint64_t{1} << lanes) - 1)) << i;
+      const std::uint64_t inside = in(pixel_words(bgr + 3 * (x + i), lanes));
+      word |= (inside & ((std::uint64_t{1} << lanes) - 1)) << i;
     }
     bits[x / 64] = word;
   }
 }
 
-void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
-  classify(
-      bgr, count, bits, [runs](const Words& words) __attribute__((always_inline)) {
-        return in_runs_lanes(runs, words);
-      });
-}
-
-void in_table(const std::uint8_t* table, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
-  classify(
-      bgr, count, bits, [table](const Words& words) __attribute__((always_inline)) {
-        return in_table_lanes(table, words);
-      });
-}
 #else
 // Without gathers: a pixel at a time; in(pixel) says whether it is in range.
 template <class In>
@@ -157,19 +144,32 @@ template <class In>
   }
 }
 
+// Whether a pixel's colour is in the box.
+[[gnu::always_inline]] inline bool runs_contain(const BlueRun* runs, const std::uint8_t* pixel) {
+  const BlueRun run = runs[pixel[1] | pixel[2] << 8];
+  return pixel[0] >= (run & 0xff) && pixel[0] <= (run >> 8);
+}
+
+[[gnu::always_inline]] inline bool table_contains(const std::uint8_t* table,
+                                                  const std::uint8_t* pixel) {
+  return table[pixel[0] | pixel[1] << 8 | pixel[2] << 16] != 0;
+}
+#endif
+
+// The pixels are a vector's words with gathers, else one pixel's bytes.
 void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
-  classify(bgr, count, bits, [runs](const std::uint8_t* pixel) {
-    const BlueRun run = runs[pixel[1] | pixel[2] << 8];
-    return pixel[0] >= (run & 0xff) && pixel[0] <= (run >> 8);
-  });
+  classify(
+      bgr, count, bits, [runs](const auto& pixels) __attribute__((always_inline)) {
+        return runs_contain(runs, pixels);
+      });
 }
 
 void in_table(const std::uint8_t* table, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
-  classify(bgr, count, bits, [table](const std::uint8_t* pixel) {
-    return table[pixel[0] | pixel[1] << 8 | pixel[2] << 16] != 0;
-  });
+  classify(
+      bgr, count, bits, [table](const auto& pixels) __attribute__((always_inline)) {
+        return table_contains(table, pixels);
+      });
 }
-#endif
 
 void write_residue_row(const std::uint64_t* unknown, const std::uint64_t* residue,
                        const float* depth_mm, int cols, std::uint8_t* mask, float* soil_mm) {
