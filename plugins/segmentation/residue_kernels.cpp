@@ -40,6 +40,8 @@ constexpr Ints kLaneBit = lane_bits(std::make_index_sequence<kLanes>());
 // b | g << 8 | r << 16, the colour's index in a table of every colour; g | r << 8 is the
 // index of its run. (12 bytes, 4 pixels, go to each 128-bit lane, then a byte shuffle
 // spreads them within the lane.)
+constexpr int kPixelsPerLookup = kLanes;
+
 [[gnu::always_inline]] inline __m128i spread_in_lane() {
   return _mm_setr_epi8(0, 1, 2, -1, 3, 4, 5, -1, 6, 7, 8, -1, 9, 10, 11, -1);
 }
@@ -115,33 +117,12 @@ using Words = __m256i;
 }
 #endif
 
-// bits for `count` pixels from bgr on; in(words) gives a vector's in-range bits.
-template <class In>
-[[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
-                                            In in) {
-  for (int x = 0; x < count; x += 64) {
-    const int pixels = count - x < 64 ? count - x : 64;
-    std::uint64_t word = 0;
-    for (int i = 0; i < pixels; i += kLanes) {
-      const int lanes = pixels - i < kLanes ? pixels - i : kLanes;
-      const std::uint64_t inside = in(pixel_words(bgr + 3 * (x + i), lanes));
-      word |= (inside & ((std::uint64_t{1} << lanes) - 1)) << i;
-    }
-    bits[x / 64] = word;
-  }
-}
-
 #else
-// Without gathers: a pixel at a time; in(pixel) says whether it is in range.
-template <class In>
-[[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
-                                            In in) {
-  for (int x = 0; x < count; x += 64) {
-    const int pixels = count - x < 64 ? count - x : 64;
-    std::uint64_t word = 0;
-    for (int i = 0; i < pixels; ++i) word |= std::uint64_t{in(bgr + 3 * (x + i))} << i;
-    bits[x / 64] = word;
-  }
+// Without gathers: a pixel at a time, its bytes where they are.
+constexpr int kPixelsPerLookup = 1;
+
+[[gnu::always_inline]] inline const std::uint8_t* pixel_words(const std::uint8_t* bgr, int) {
+  return bgr;
 }
 
 // Whether a pixel's colour is in the box.
@@ -156,7 +137,23 @@ template <class In>
 }
 #endif
 
-// The pixels are a vector's words with gathers, else one pixel's bytes.
+// bits for `count` pixels from bgr on; in(pixel_words(...)) gives the in-range bits of
+// kPixelsPerLookup pixels.
+template <class In>
+[[gnu::always_inline]] inline void classify(const std::uint8_t* bgr, int count, std::uint64_t* bits,
+                                            In in) {
+  for (int x = 0; x < count; x += 64) {
+    const int pixels = count - x < 64 ? count - x : 64;
+    std::uint64_t word = 0;
+    for (int i = 0; i < pixels; i += kPixelsPerLookup) {
+      const int lanes = pixels - i < kPixelsPerLookup ? pixels - i : kPixelsPerLookup;
+      const std::uint64_t inside = in(pixel_words(bgr + 3 * (x + i), lanes));
+      word |= (inside & ((std::uint64_t{1} << lanes) - 1)) << i;
+    }
+    bits[x / 64] = word;
+  }
+}
+
 void in_runs(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits) {
   classify(
       bgr, count, bits, [runs](const auto& pixels) __attribute__((always_inline)) {
