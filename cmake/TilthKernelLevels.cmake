@@ -1,7 +1,7 @@
 # tilth_add_kernel_levels(NAME SOURCES src... DISPATCH src... [LIBRARIES lib...])
 # Builds the static library NAME from SOURCES compiled once per instruction-set level --
-# the baseline and, on x86-64, x86-64-v2 (SSE4.2), x86-64-v3 (AVX2, FMA) and x86-64-v4
-# (AVX-512), each with -march=<level> -- and DISPATCH, compiled once, which picks among
+# the baseline (on x86-64, -march=x86-64: SSE2) and x86-64-v2 (SSE4.2), x86-64-v3 (AVX2,
+# FMA) and x86-64-v4 (AVX-512), each with -march=<level> -- and DISPATCH, compiled once, which picks among
 # them (tilth/kernel_levels.h). SOURCES see TILTH_KERNEL_LEVEL, the level's namespace
 # (baseline, x86_64_v2, ...), and TILTH_KERNEL_LEVEL_NAME, its name; DISPATCH sees
 # TILTH_KERNEL_LEVELS_X86_64 where the x86-64 levels are built. Used in this tree and,
@@ -24,6 +24,8 @@ function(tilth_add_kernel_levels name)
       TILTH_KERNEL_LEVEL=${namespace} TILTH_KERNEL_LEVEL_NAME="${level}")
     if(NOT level STREQUAL "baseline")
       target_compile_options(${target} PRIVATE -march=${level})
+    elseif(x86_64)
+      target_compile_options(${target} PRIVATE -march=x86-64)  # whatever the default flags
     endif()
     target_link_libraries(${target} PRIVATE Tilth::sdk ${ARG_LIBRARIES})
     list(APPEND objects $<TARGET_OBJECTS:${target}>)

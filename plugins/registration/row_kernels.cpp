@@ -2,6 +2,7 @@
 // per level with -march=<level> and TILTH_KERNEL_LEVEL naming its namespace. Everything
 // here stays in that namespace or is always inlined, so that no function compiled for
 // one level can stand in for another's at link time.
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +16,8 @@
 #include "lens_model.h"
 #include "row_kernels.h"
 #include "tilth/kernel_level.h"
+
+static_assert(std::endian::native == std::endian::little, "pixels' bytes are read as words");
 
 namespace tilth::registration::TILTH_KERNEL_LEVEL {
 namespace {
@@ -110,7 +113,7 @@ void project_vectors(const ProjectionModel& m, const float* xs, const float* ys,
   const Floats u_end = splat(static_cast<float>(m.color_width) - 0.5f - m.edge_margin_px);
   const Floats v_end = splat(static_cast<float>(m.color_height) - 0.5f - m.edge_margin_px);
   const Floats max_radius2 = splat(m.max_radius2);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   const Floats not_shown = splat(nan);
   const lens::Distortion<Floats> distortion{
       splat(m.k[0]), splat(m.k[1]), splat(m.k[2]), splat(m.k[3]), splat(m.k[4]), one, splat(2.0f)};

@@ -3,8 +3,8 @@
 // what cv::cvtColor + cv::inRange would. The table is a byte per colour (16 MB, on 2 MB
 // pages: a frame's colours lie on a thousand or more 4 KB pages, too many for the TLB),
 // unless for every green and red the box holds one run of blues (true of the HSV boxes of
-// soil and straw): then it is that run's first and last blue, 128 KB, read with vector
-// gathers where the CPU has them (ResidueKernels). A camera's noise spreads a frame's
+// soil and straw): then it is that run's first and last blue, 128 KB. Either is read with
+// vector gathers where the CPU has them (ResidueKernels). A camera's noise spreads a frame's
 // colours over much of the 16 MB, and the lookups then wait on memory.
 #pragma once
 
@@ -24,7 +24,7 @@ class ColorRangeTable {
   // the box is in BGR itself. `lower`, `upper`: inclusive 8-bit bounds per channel.
   ColorRangeTable(int conversion, const std::array<int, 3>& lower, const std::array<int, 3>& upper);
 
-  // For `count` BGR pixels (3 bytes each): bit i of bits[i / 64] set where pixel i is
+  // For `count` BGR pixels (3 bytes each): bit i % 64 of bits[i / 64] set where pixel i is
   // inside the box (where cv::inRange writes 255); bits from `count` on in the last word
   // are 0.
   void classify_row(const ResidueKernels& kernels, const std::uint8_t* bgr, int count,

@@ -2,6 +2,7 @@
 // once per level with -march=<level> and TILTH_KERNEL_LEVEL naming its namespace.
 // Everything here stays in that namespace or is always inlined, so that no function
 // compiled for one level can stand in for another's at link time.
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -14,6 +15,11 @@
 #include "residue_kernels.h"
 #include "tilth/kernel_level.h"
 #include "tilth/messages/residue_mask.h"
+
+#if defined(__AVX512F__) && !defined(__AVX512BW__)
+#error "AVX-512 without its byte and word instructions (BW): no level of x86-64 is so"
+#endif
+static_assert(std::endian::native == std::endian::little, "a pixel's bytes are read as a word");
 
 namespace tilth::segmentation::TILTH_KERNEL_LEVEL {
 namespace {

@@ -13,7 +13,7 @@ namespace tilth::segmentation {
 using BlueRun = std::uint16_t;
 
 struct ResidueKernels {
-  // Bit i of bits[i / 64] set where BGR pixel i of `count` (3 bytes each) lies in the box
+  // Bit i % 64 of bits[i / 64] set where BGR pixel i of `count` (3 bytes each) lies in the box
   // of `runs`, indexed by green + 256 * red, which holds one entry more than that, so
   // that each run can be read as a word. Bits from `count` on in the last word are 0.
   void (*in_runs)(const BlueRun* runs, const std::uint8_t* bgr, int count, std::uint64_t* bits);

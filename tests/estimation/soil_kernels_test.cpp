@@ -41,12 +41,19 @@ TEST(SoilKernels, CollectFiniteKeepsEveryFiniteDepthInOrderAtEveryLevel) {
     ASSERT_GT(expected.size(), depth.size() / 4);
 
     for (const SoilKernels* kernels : available_soil_kernels()) {
-      std::vector<float> collected(depth.size() + kSlack, -1.0f);
+      constexpr int kGuard = 8;  // past the slack: never written
+      std::vector<float> collected(depth.size() + kSlack + kGuard, -1.0f);
       CollectedDepths state{collected.data(), std::numeric_limits<float>::max(),
                             -std::numeric_limits<float>::max()};
       for (int row = 0; row < kRows; ++row) {
         state = kernels->collect_finite(depth.data() + row * cols, cols, state);
       }
+      const std::size_t written_up_to = expected.size() + kSlack;
+      int guard_written = 0;
+      for (std::size_t i = written_up_to; i < collected.size(); ++i) {
+        guard_written += collected[i] != -1.0f ? 1 : 0;
+      }
+      EXPECT_EQ(guard_written, 0) << kernels->level;
       collected.resize(static_cast<std::size_t>(state.end - collected.data()));
       EXPECT_EQ(collected, expected) << kernels->level << ", " << cols << " px";
       EXPECT_EQ(state.lowest, lowest) << kernels->level;

@@ -1,3 +1,5 @@
+// The levels of count_kernels.cpp that were built (TILTH_KERNEL_LEVELS_X86_64: the x86-64
+// ones).
 #include "count_kernels.h"
 #include "tilth/kernel_levels.h"
 
