@@ -58,3 +58,37 @@ class KernelLevels {
 };
 
 }  // namespace tilth
+
+// In a dispatch source, inside the namespace holding the levels' namespaces: declares
+// each level's `const Kernels symbol` (defined by the kernel source in its level's
+// namespace) and defines `const tilth::KernelLevels<Kernels>& name()`, the levels built,
+// widest first.
+#ifdef TILTH_KERNEL_LEVELS_X86_64
+#define TILTH_KERNEL_LEVELS(Kernels, symbol, name)                                             \
+  namespace x86_64_v4 {                                                                        \
+  extern const Kernels symbol;                                                                 \
+  }                                                                                            \
+  namespace x86_64_v3 {                                                                        \
+  extern const Kernels symbol;                                                                 \
+  }                                                                                            \
+  namespace x86_64_v2 {                                                                        \
+  extern const Kernels symbol;                                                                 \
+  }                                                                                            \
+  namespace baseline {                                                                         \
+  extern const Kernels symbol;                                                                 \
+  }                                                                                            \
+  const ::tilth::KernelLevels<Kernels>& name() {                                               \
+    static const ::tilth::KernelLevels<Kernels> levels{&x86_64_v4::symbol, &x86_64_v3::symbol, \
+                                                       &x86_64_v2::symbol, &baseline::symbol}; \
+    return levels;                                                                             \
+  }
+#else
+#define TILTH_KERNEL_LEVELS(Kernels, symbol, name)                         \
+  namespace baseline {                                                     \
+  extern const Kernels symbol;                                             \
+  }                                                                        \
+  const ::tilth::KernelLevels<Kernels>& name() {                           \
+    static const ::tilth::KernelLevels<Kernels> levels{&baseline::symbol}; \
+    return levels;                                                         \
+  }
+#endif
