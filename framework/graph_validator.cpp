@@ -103,7 +103,7 @@ class Validator {
                                           ", got " + describe_value(value));
         continue;
       }
-      if (param.type == ParamType::kPath) {
+      if (param.type == ParamType::kPath && !value.get<std::string>().empty()) {
         const fs::path path = value.get<std::string>();
         value = path.is_absolute() ? path.string()
                                    : (given.base_dir / path).lexically_normal().string();

@@ -2,9 +2,11 @@
 // Mono16 or Coord3D_C16 pixels are passed on without copying, with the camera's own
 // scale and offset to millimetres (Scan3dCoordinateScale / Scan3dCoordinateOffset) when
 // it has them. The range component is selected on cameras with components, and taken
-// from multi-part payloads by its component id.
+// from multi-part payloads by its component id. Given the rig's calibration, its frames
+// carry it (tilth/frame_calibration.h).
 #include "camera_source.h"
 #include "camera_stages.h"
+#include "tilth/calibration.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/plugin.h"
 
@@ -20,9 +22,15 @@ CameraSettings tof_settings(const Params& params) {
 class TofCamera final : public CameraSource {
  public:
   explicit TofCamera(const StageContext& context)
-      : CameraSource(tof_settings(context.params), context) {}
+      : CameraSource(tof_settings(context.params), context), rig_(rig(context.params)) {}
 
  private:
+  static std::shared_ptr<const RigCalibration> rig(const Params& params) {
+    const std::filesystem::path file = params.path("calibration");
+    if (file.empty()) return nullptr;
+    return std::make_shared<const RigCalibration>(load_calibration(file));
+  }
+
   std::shared_ptr<const Message> convert(const BufferLayout& layout, PoppedBuffer& buffer,
                                          const CameraDescription& camera,
                                          std::int64_t device_timestamp_ns) override {
@@ -38,8 +46,11 @@ class TofCamera final : public CameraSource {
     raw->device_timestamp_ns = device_timestamp_ns;
     raw->scale_mm = camera.scale_mm;
     raw->offset_mm = camera.offset_mm;
+    raw->rig = rig_;
     return raw;
   }
+
+  const std::shared_ptr<const RigCalibration> rig_;
 };
 
 }  // namespace
@@ -59,6 +70,9 @@ StageDescriptor describe_tof_camera() {
       ParamSpec::string("component", "Range")
           .describe("GenICam component to stream (ComponentSelector), enabled alone; its part "
                     "is taken from multi-part payloads; cameras without components ignore it"));
+  d.params.push_back(ParamSpec::path("calibration", "")
+                         .describe("the rig's calibration file, carried by every frame for the "
+                                   "stages after it; \"\" = none"));
   d.create = factory<TofCamera>();
   return d;
 }

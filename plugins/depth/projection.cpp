@@ -4,7 +4,9 @@
 //                                            factor = 1                       (z)
 // with (x', y') the undistorted normalised coordinates of pixel (u, v). The factor
 // depends on the calibration only, so it is an image computed once in the constructor
-// and a frame costs two multiply-adds per pixel, four pixels at a time. Gray 0 -> NaN.
+// and a frame costs two multiply-adds per pixel, four pixels at a time. Gray 0 (no
+// measurement) and gray at or above `saturated_gray` (the sensor's ceiling: saturated, or
+// beyond its range) -> NaN: neither says where the surface is.
 #include "projection.h"
 
 #include <cmath>
@@ -17,6 +19,7 @@
 #include "lens_model.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
+#include "tilth/frame_calibration.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -46,30 +49,42 @@ std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
+// What a frame's projection needs from its calibration.
+struct Projection {
+  DepthCameraCalibration camera;
+  cv::Mat factor;  // CV_32FC1, see the top of the file
+};
+
 class DepthProjection final : public Transform {
  public:
   explicit DepthProjection(const StageContext& context)
-      : file_(context.params.path("calibration").string()),
-        camera_(load_calibration(file_).depth),
-        factor_(range_to_depth_factor(camera_, file_)) {}
+      : calibration_(context.params, context.log,
+                     [](const RigCalibration& rig) {
+                       return Projection{rig.depth, range_to_depth_factor(rig.depth, rig.origin)};
+                     }),
+        saturated_gray_(static_cast<std::uint16_t>(context.params.integer("saturated_gray"))) {}
 
   void process(Frame& frame) override {
     const auto& raw = frame.input<RawTofFrame>(0);
+    const auto used = calibration_.for_frame(raw.rig);
+    const DepthCameraCalibration& camera = used->derived.camera;
     if (raw.gray.type() != CV_16UC1) {
       throw Error("raw ToF frame has pixel type " + cv::typeToString(raw.gray.type()) +
                   "; expected CV_16UC1 (16-bit gray)");
     }
-    if (raw.gray.cols != camera_.width || raw.gray.rows != camera_.height) {
+    if (raw.gray.cols != camera.width || raw.gray.rows != camera.height) {
       throw Error("raw ToF frame is " + size_text(raw.gray.cols, raw.gray.rows) +
-                  " px but the calibration " + file_ + " is for " +
-                  size_text(camera_.width, camera_.height) + " px");
+                  " px but the calibration " + used->rig->origin + " is for " +
+                  size_text(camera.width, camera.height) + " px");
     }
-    const auto scale = static_cast<float>(raw.scale_mm.value_or(camera_.gray_to_mm));
-    const auto offset = static_cast<float>(raw.offset_mm.value_or(camera_.gray_offset_mm));
-    const auto z_offset = static_cast<float>(camera_.z_offset_mm);
+    const auto scale = static_cast<float>(raw.scale_mm.value_or(camera.gray_to_mm));
+    const auto offset = static_cast<float>(raw.offset_mm.value_or(camera.gray_offset_mm));
+    const auto z_offset = static_cast<float>(camera.z_offset_mm);
     constexpr float kNoDepth = std::numeric_limits<float>::quiet_NaN();
     const auto project = [&](std::uint16_t gray, float factor) {
-      return gray == 0 ? kNoDepth : (static_cast<float>(gray) * scale + offset) * factor - z_offset;
+      return gray == 0 || gray >= saturated_gray_
+                 ? kNoDepth
+                 : (static_cast<float>(gray) * scale + offset) * factor - z_offset;
     };
     using cv::v_float32x4;
     const v_float32x4 scale4 = cv::v_setall_f32(scale);
@@ -77,21 +92,23 @@ class DepthProjection final : public Transform {
     const v_float32x4 minus_z_offset4 = cv::v_setall_f32(-z_offset);
     const v_float32x4 no_depth4 = cv::v_setall_f32(kNoDepth);
     const v_float32x4 zero4 = cv::v_setall_f32(0.0f);
+    const v_float32x4 saturated4 = cv::v_setall_f32(saturated_gray_);
     const auto project4 = [&](const cv::v_uint32x4& gray, const float* factor) {
       const v_float32x4 g = cv::v_cvt_f32(cv::v_reinterpret_as_s32(gray));
       const v_float32x4 z =
           cv::v_muladd(cv::v_muladd(g, scale4, offset4), cv::v_load(factor), minus_z_offset4);
-      return cv::v_select(g == zero4, no_depth4, z);
+      return cv::v_select((g == zero4) | (g >= saturated4), no_depth4, z);
     };
 
     auto depth = pool_.acquire();
-    reuse_or_create(depth->mm, camera_.height, camera_.width, CV_32FC1);
+    depth->rig = used->rig;
+    reuse_or_create(depth->mm, camera.height, camera.width, CV_32FC1);
     const bool one_row = raw.gray.isContinuous() && depth->mm.isContinuous();
-    const int rows = one_row ? 1 : camera_.height;
-    const int cols = one_row ? camera_.height * camera_.width : camera_.width;
+    const int rows = one_row ? 1 : camera.height;
+    const int cols = one_row ? camera.height * camera.width : camera.width;
     for (int v = 0; v < rows; ++v) {
       const auto* gray = raw.gray.ptr<std::uint16_t>(v);
-      const auto* factor = factor_.ptr<float>(v);
+      const auto* factor = used->derived.factor.ptr<float>(v);
       auto* z = depth->mm.ptr<float>(v);
       int u = 0;
       for (; u + 8 <= cols; u += 8) {  // eight 16-bit gray values, as two sets of four floats
@@ -107,9 +124,8 @@ class DepthProjection final : public Transform {
   }
 
  private:
-  const std::string file_;
-  const DepthCameraCalibration camera_;
-  const cv::Mat factor_;  // CV_32FC1, see the top of the file
+  FrameCalibration<Projection> calibration_;
+  const std::uint16_t saturated_gray_;
   MessagePool<DepthImage> pool_;
 };
 
@@ -122,7 +138,12 @@ StageDescriptor describe_projection() {
       "raw ToF gray -> depth in mm from the mounting surface along the optical axis (eq. 1)";
   d.inputs = {PortSpec::of<RawTofFrame>("raw", "16-bit gray; 0 = no measurement")};
   d.outputs = {PortSpec::of<DepthImage>("depth", "mm from the mounting surface; NaN = no depth")};
-  d.params = {ParamSpec::path("calibration", std::nullopt).describe("rig calibration file")};
+  d.params = {
+      frame_calibration_param(),
+      ParamSpec::integer("saturated_gray", 65535)
+          .range(1, 65535)
+          .describe("gray at or above this is saturated or beyond range: no depth"),
+  };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<DepthProjection>();
   return d;

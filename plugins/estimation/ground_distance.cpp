@@ -1,11 +1,14 @@
 // estimation.ground_distance: the paper's last step (section 2.4) -- one ground distance
 // from the soil depths left in a region of interest, as a robust statistic.
 //
-//   soil_depth ──► finite depths in roi ──► enough soil? ──► median | trimmed mean ──► distance
-//                                               └── no ──► invalid, with the reason
+//   color? ──► usable in roi? ─┐
+//   soil_depth ──► finite depths in roi ──► enough soil? ──► median | trimmed mean ──► gates ──►
+//   distance
+//                                  └── no ──────┴── no ──► invalid, with its cause and reason
 //
 // Invariant: an invalid measurement carries distance_mm 0 and confidence 0; too little
-// visible soil is never turned into a guess.
+// visible soil, unusable colour or an implausible number (plausibility.h) is never served
+// as valid.
 //
 //   "estimate": {"type": "estimation.ground_distance",
 //                "params": {"roi": {"x": 160, "y": 120, "width": 320, "height": 240},
@@ -20,6 +23,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "estimators.h"
+#include "plausibility.h"
 #include "rank_selection.h"
 #include "soil_kernels.h"
 #include "soil_region.h"
@@ -27,6 +31,7 @@
 #include "tilth/message_pool.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
+#include "tilth/messages/registered_color.h"
 #include "tilth/plugin.h"
 
 namespace tilth::estimation {
@@ -64,17 +69,19 @@ enum class Statistic { kMedian, kTrimmedMean };
 
 class GroundDistanceEstimator final : public Transform {
  public:
+  enum Port { kSoilDepth = 0, kColor = 1 };
+
   explicit GroundDistanceEstimator(const StageContext& context)
       : region_(context.params.json("roi")),
         statistic_(context.params.string("statistic") == "median" ? Statistic::kMedian
                                                                   : Statistic::kTrimmedMean),
         trim_fraction_(context.params.number("trim_fraction")),
         requirement_(soil_requirement(context.params)),
-        max_spread_mm_(context.params.number("max_spread_mm")),
+        gates_(context.params),
         log_(context.log) {}
 
   void process(Frame& frame) override {
-    const auto& soil = frame.input<DepthImage>(0);
+    const auto& soil = frame.input<DepthImage>(kSoilDepth);
     if (soil.mm.type() != CV_32FC1) {
       throw Error("input 'soil_depth': expected a CV_32FC1 image in mm, got type " +
                   std::to_string(soil.mm.type()));
@@ -92,8 +99,19 @@ class GroundDistanceEstimator final : public Transform {
     out = GroundDistance{};  // a reused message keeps its string's buffer
     out.soil_pixels = static_cast<std::int64_t>(depths.mm.size());
     out.soil_fraction = static_cast<double>(depths.mm.size()) / roi.area();
-    out.invalid_reason = requirement_.shortfall(out.soil_pixels, roi.area());
-    if (out.invalid_reason.empty()) measure(depths, out);
+    if (const Packet& color = frame.input(kColor); !color.empty()) {
+      if (auto unusable = gates_.unusable_color(color.get<RegisteredColor>(), roi)) {
+        out.invalidate(InvalidCause::kImageUnusable, std::move(*unusable));
+        frame.set_output(0, message);
+        return;
+      }
+    }
+    if (auto shortfall = requirement_.shortfall(out.soil_pixels, roi.area()); !shortfall.empty()) {
+      out.invalidate(InvalidCause::kTooLittleSoil, std::move(shortfall));
+    } else {
+      measure(depths, out);
+      gates_.check(out);
+    }
     frame.set_output(0, message);
   }
 
@@ -135,11 +153,6 @@ class GroundDistanceEstimator final : public Transform {
         depths.mm, 0.0f,
         std::max(deviation(depths.lowest, median_mm), deviation(depths.highest, median_mm)));
     out.spread_mm = kMadToSigma * ranks.median();
-    if (max_spread_mm_ > 0 && out.spread_mm > max_spread_mm_) {
-      out.invalid_reason = "soil depths spread too widely: " + one_decimal(out.spread_mm) +
-                           " mm > " + one_decimal(max_spread_mm_) + " mm (not one surface?)";
-      return;
-    }
     out.distance_mm = distance_mm;
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm);
@@ -150,7 +163,7 @@ class GroundDistanceEstimator final : public Transform {
   const Statistic statistic_;
   const double trim_fraction_;
   const SoilRequirement requirement_;
-  const double max_spread_mm_;
+  const PlausibilityGates gates_;
   const Logger log_;
   std::once_flag clipping_logged_;
   MessagePool<GroundDistance> outputs_;
@@ -162,7 +175,10 @@ StageDescriptor describe_ground_distance() {
   StageDescriptor d;
   d.type = "estimation.ground_distance";
   d.summary = "ground distance = robust statistic of the soil depths in a region of interest";
-  d.inputs = {PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere")};
+  d.inputs = {
+      PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere"),
+      PlausibilityGates::color_port(),
+  };
   d.outputs = {PortSpec::of<GroundDistance>(
       "distance", "distance, validity, soil fraction, spread (1.4826 MAD), confidence")};
   d.params = {
@@ -174,11 +190,9 @@ StageDescriptor describe_ground_distance() {
           .describe("trimmed_mean: fraction of the depths dropped at each end"),
       min_soil_fraction_param(),
       min_soil_pixels_param(),
-      ParamSpec::number("max_spread_mm", 0.0)
-          .range(0, std::nullopt)
-          .in_unit("mm")
-          .describe("above this spread (1.4826 MAD) the measurement is invalid; 0 = no limit"),
   };
+  const auto gates = PlausibilityGates::params();
+  d.params.insert(d.params.end(), gates.begin(), gates.end());
   d.concurrency = Concurrency::kParallel;
   d.create = factory<GroundDistanceEstimator>();
   return d;

@@ -15,7 +15,7 @@
 // atan(dZ/dX) (about the y axis; positive when it is farther towards +x, the right).
 //
 //   "estimate": {"type": "estimation.ground_plane",
-//                "params": {"calibration": "rig.calib.json", "tool_point": [0, 120]}}
+//                "params": {"tool_point": [0, 120]}}
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -29,11 +29,14 @@
 #include <opencv2/calib3d.hpp>
 
 #include "estimators.h"
+#include "plausibility.h"
 #include "soil_region.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
+#include "tilth/frame_calibration.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
+#include "tilth/messages/registered_color.h"
 #include "tilth/plugin.h"
 
 namespace tilth::estimation {
@@ -201,50 +204,79 @@ std::vector<GridPixel> sampling_grid(const DepthCameraCalibration& camera, const
   return grid;
 }
 
+// What fitting a frame's plane needs from its calibration.
+struct Sampling {
+  DepthCameraCalibration camera;
+  cv::Size image_size;
+  cv::Rect roi;
+  std::vector<GridPixel> grid;
+};
+
 class GroundPlaneEstimator final : public Transform {
  public:
+  enum Port { kSoilDepth = 0, kColor = 1 };
+
   explicit GroundPlaneEstimator(const StageContext& context)
-      : camera_(load_calibration(context.params.path("calibration")).depth),
-        image_size_(camera_.width, camera_.height),
-        region_(context.params.json("roi")),
-        roi_(region_.on(image_size_)),
+      : region_(context.params.json("roi")),
         tool_point_mm_(parse_tool_point(context.params.json("tool_point"))),
         requirement_(soil_requirement(context.params)),
         threshold_mm_(context.params.number("outlier_threshold_mm")),
         hypotheses_(static_cast<int>(context.params.integer("iterations"))),
         min_inlier_fraction_(context.params.number("min_inlier_fraction")),
-        grid_(sampling_grid(camera_, roi_, static_cast<int>(context.params.integer("stride")))) {
-    if (region_.clipped_on(image_size_)) context.log.warning(region_.clipping_note(image_size_));
-  }
+        gates_(context.params),
+        calibration_(
+            context.params, context.log,
+            [this, log = context.log, stride = static_cast<int>(context.params.integer("stride"))](
+                const RigCalibration& rig) {
+              const cv::Size size(rig.depth.width, rig.depth.height);
+              if (region_.clipped_on(size)) log.warning(region_.clipping_note(size));
+              const cv::Rect roi = region_.on(size);
+              return Sampling{rig.depth, size, roi, sampling_grid(rig.depth, roi, stride)};
+            }) {}
 
   void process(Frame& frame) override {
-    const auto& soil = frame.input<DepthImage>(0);
-    if (soil.mm.type() != CV_32FC1 || soil.mm.size() != image_size_) {
-      throw Error("input 'soil_depth': expected a CV_32FC1 " + size_text(image_size_) +
+    const auto& soil = frame.input<DepthImage>(kSoilDepth);
+    const auto used = calibration_.for_frame(soil.rig);
+    const Sampling& sampling = used->derived;
+    if (soil.mm.type() != CV_32FC1 || soil.mm.size() != sampling.image_size) {
+      throw Error("input 'soil_depth': expected a CV_32FC1 " + size_text(sampling.image_size) +
                   " image (the calibration's depth camera), got type " +
                   std::to_string(soil.mm.type()) + ", " + size_text(soil.mm.size()));
     }
+    const cv::Rect& roi = sampling.roi;
     GroundDistance out;
-    out.soil_pixels = count_finite(soil.mm, roi_);
-    out.soil_fraction = static_cast<double>(out.soil_pixels) / roi_.area();
-    out.invalid_reason = requirement_.shortfall(out.soil_pixels, roi_.area());
-    if (out.invalid_reason.empty()) measure(soil.mm, out);
+    out.soil_pixels = count_finite(soil.mm, roi);
+    out.soil_fraction = static_cast<double>(out.soil_pixels) / roi.area();
+    if (const Packet& color = frame.input(kColor); !color.empty()) {
+      if (auto unusable = gates_.unusable_color(color.get<RegisteredColor>(), roi)) {
+        out.invalidate(InvalidCause::kImageUnusable, std::move(*unusable));
+        frame.emit(0, std::move(out));
+        return;
+      }
+    }
+    if (auto shortfall = requirement_.shortfall(out.soil_pixels, roi.area()); !shortfall.empty()) {
+      out.invalidate(InvalidCause::kTooLittleSoil, std::move(shortfall));
+    } else {
+      measure(sampling, soil.mm, out);
+      gates_.check(out);
+    }
     frame.emit(0, std::move(out));
   }
 
  private:
-  void measure(const cv::Mat& soil_mm, GroundDistance& out) const {
+  void measure(const Sampling& sampling, const cv::Mat& soil_mm, GroundDistance& out) const {
+    const DepthCameraCalibration& camera = sampling.camera;
     thread_local std::vector<SoilPoint> points;
     thread_local std::vector<bool> inliers;
     points.clear();
-    for (const GridPixel& pixel : grid_) {
+    for (const GridPixel& pixel : sampling.grid) {
       const float depth = soil_mm.at<float>(pixel.row, pixel.col);
-      if (std::isfinite(depth)) points.push_back({pixel.x, pixel.y, depth + camera_.z_offset_mm});
+      if (std::isfinite(depth)) points.push_back({pixel.x, pixel.y, depth + camera.z_offset_mm});
     }
     if (points.size() < 3) {
-      out.invalid_reason =
-          "too few soil points on the sampling grid: " + std::to_string(points.size()) +
-          " < 3 (lower 'stride')";
+      out.invalidate(InvalidCause::kTooLittleSoil,
+                     "too few soil points on the sampling grid: " + std::to_string(points.size()) +
+                         " < 3 (lower 'stride')");
       return;
     }
 
@@ -252,22 +284,25 @@ class GroundPlaneEstimator final : public Transform {
     const std::optional<PlaneFit> fitted =
         guess ? refine(points, *guess, threshold_mm_, inliers) : std::nullopt;
     if (!fitted) {
-      out.invalid_reason = "no plane fits the soil points (fewer than 3 inliers, or all on a line)";
+      out.invalidate(InvalidCause::kNotOneSurface,
+                     "no plane fits the soil points (fewer than 3 inliers, or all on a line)");
       return;
     }
     const double inlier_fraction =
         static_cast<double>(fitted->inliers) / static_cast<double>(points.size());
     if (inlier_fraction < min_inlier_fraction_) {
-      out.invalid_reason = "no plane fits the soil: " + one_decimal(100.0 * inlier_fraction) +
-                           " % of the soil points lie within " + one_decimal(threshold_mm_) +
-                           " mm of the best plane < " + one_decimal(100.0 * min_inlier_fraction_) +
-                           " %";
+      out.invalidate(InvalidCause::kNotOneSurface,
+                     "no plane fits the soil: " + one_decimal(100.0 * inlier_fraction) +
+                         " % of the soil points lie within " + one_decimal(threshold_mm_) +
+                         " mm of the best plane < " + one_decimal(100.0 * min_inlier_fraction_) +
+                         " %");
       return;
     }
     const Plane& plane = fitted->plane;
     const double depth_at_tool = plane.depth_at(tool_point_mm_[0], tool_point_mm_[1]);
     if (!std::isfinite(depth_at_tool) || depth_at_tool <= 0) {
-      out.invalid_reason = "the fitted plane does not lie in front of the camera at the tool point";
+      out.invalidate(InvalidCause::kOutOfRange,
+                     "the fitted plane does not lie in front of the camera at the tool point");
       return;
     }
 
@@ -278,23 +313,21 @@ class GroundPlaneEstimator final : public Transform {
       squares += residual_mm * residual_mm;
     }
     out.spread_mm = std::sqrt(squares / static_cast<double>(fitted->inliers));
-    out.distance_mm = depth_at_tool - camera_.z_offset_mm;
+    out.distance_mm = depth_at_tool - camera.z_offset_mm;
     out.tilt_x_deg = degrees(std::atan(plane.slope_y()));
     out.tilt_y_deg = degrees(std::atan(plane.slope_x()));
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
   }
 
-  const DepthCameraCalibration camera_;
-  const cv::Size image_size_;
   const RegionOfInterest region_;
-  const cv::Rect roi_;
   const cv::Vec2d tool_point_mm_;
   const SoilRequirement requirement_;
   const double threshold_mm_;
   const int hypotheses_;
   const double min_inlier_fraction_;
-  const std::vector<GridPixel> grid_;
+  const PlausibilityGates gates_;
+  FrameCalibration<Sampling> calibration_;
 };
 
 }  // namespace
@@ -303,12 +336,12 @@ StageDescriptor describe_ground_plane() {
   StageDescriptor d;
   d.type = "estimation.ground_plane";
   d.summary = "ground distance at the tool and ground tilt from a robust plane fit to the soil";
-  d.inputs = {PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere")};
+  d.inputs = {PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere"),
+              PlausibilityGates::color_port()};
   d.outputs = {PortSpec::of<GroundDistance>(
       "distance", "distance at the tool point, tilt, validity, spread (inlier RMS), confidence")};
   d.params = {
-      ParamSpec::path("calibration", std::nullopt)
-          .describe("rig calibration file (tilth-calibration/1); its depth camera is used"),
+      frame_calibration_param(),
       roi_param(),
       ParamSpec::json("tool_point", nlohmann::json::array({0.0, 0.0}))
           .in_unit("mm")
@@ -330,6 +363,8 @@ StageDescriptor describe_ground_plane() {
           .in_unit("px")
           .describe("fit every stride-th pixel in each direction of the roi"),
   };
+  const auto gates = PlausibilityGates::params();
+  d.params.insert(d.params.end(), gates.begin(), gates.end());
   d.concurrency = Concurrency::kParallel;
   d.create = factory<GroundPlaneEstimator>();
   return d;

@@ -68,7 +68,7 @@ class McapPlayer final : public Source {
  public:
   explicit McapPlayer(const StageContext& context)
       : reader_(context.params.path("path")),
-        calibration_(read_calibration(reader_)),
+        calibration_(std::make_shared<const RigCalibration>(read_calibration(reader_))),
         clock_(context.params.number("rate")),
         host_time_(context.params),
         log_(context.log) {
@@ -211,13 +211,14 @@ class McapPlayer final : public Source {
   };
 
   Outputs decode(const RecordedFrame& recorded) const {
-    const cv::Size depth_size(calibration_.depth.width, calibration_.depth.height);
-    const cv::Size color_size(calibration_.color.width, calibration_.color.height);
+    const cv::Size depth_size(calibration_->depth.width, calibration_->depth.height);
+    const cv::Size color_size(calibration_->color.width, calibration_->color.height);
     Outputs outputs;
 
     RawImage raw_image = image(*recorded.raw, depth_size, "mono16");
     outputs.raw.gray = std::move(raw_image.pixels);
     outputs.raw.device_timestamp_ns = raw_image.timestamp_ns;
+    outputs.raw.rig = calibration_;
 
     RawImage color_image = image(*recorded.color, color_size, "");
     const std::optional<PixelFormat> format = parse_pixel_format(color_image.encoding);
@@ -248,7 +249,7 @@ class McapPlayer final : public Source {
   }
 
   McapReader reader_;
-  const RigCalibration calibration_;
+  const std::shared_ptr<const RigCalibration> calibration_;  // the frames carry it
   PlaybackClock clock_;
   const ReplayHostTime host_time_;
   const Logger log_;

@@ -1,23 +1,14 @@
 #include "latest_measurement.h"
 
 #include <algorithm>
-#include <cctype>
 
 namespace tilth::modbus {
-
-bool is_too_little_soil(const GroundDistance& distance) {
-  if (distance.valid) return false;
-  std::string reason = distance.invalid_reason;
-  std::transform(reason.begin(), reason.end(), reason.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return reason.find("soil") != std::string::npos;
-}
 
 void LatestMeasurement::update(std::uint64_t frame_id, const GroundDistance& distance,
                                Clock::time_point arrived, std::chrono::milliseconds capture_age) {
   Measurement measurement{frame_id,
                           distance.valid,
-                          is_too_little_soil(distance),
+                          distance.valid ? InvalidCause::kNone : distance.cause,
                           distance.distance_mm,
                           distance.soil_fraction,
                           distance.confidence,
@@ -54,7 +45,7 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
       std::chrono::duration_cast<std::chrono::milliseconds>(now - measurement_->arrived);
   values.stale = since_arrival > stale_timeout_;
   values.valid = measurement_->valid && !values.stale && !last_frame_missing_;
-  values.too_little_soil = measurement_->too_little_soil;
+  values.cause = measurement_->cause;
   values.distance_mm = measurement_->distance_mm;
   values.soil_fraction = measurement_->soil_fraction;
   values.confidence = measurement_->confidence;

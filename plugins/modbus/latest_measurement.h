@@ -37,7 +37,7 @@ class LatestMeasurement {
   struct Measurement {
     std::uint64_t frame_id = 0;
     bool valid = false;
-    bool too_little_soil = false;
+    InvalidCause cause = InvalidCause::kNone;
     double distance_mm = 0.0;
     double soil_fraction = 0.0;
     double confidence = 0.0;
@@ -52,9 +52,5 @@ class LatestMeasurement {
   bool last_frame_missing_ = false;
   bool cameras_streaming_ = true;  // until a camera status says otherwise
 };
-
-// The estimator says why a measurement is invalid in words; "too little soil" is the
-// reason the PLC is told apart, so any reason that mentions soil counts.
-bool is_too_little_soil(const GroundDistance& distance);
 
 }  // namespace tilth::modbus

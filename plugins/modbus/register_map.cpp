@@ -24,6 +24,23 @@ void put(RegisterBlock& block, std::size_t offset, std::array<std::uint16_t, 2> 
   block[offset + 1] = words[1];
 }
 
+// The status bit that tells a PLC the kind of cause.
+std::uint16_t cause_bits(InvalidCause cause) {
+  switch (cause) {
+    case InvalidCause::kNone:
+      return 0;
+    case InvalidCause::kTooLittleSoil:
+      return kTooLittleSoil;
+    case InvalidCause::kNotOneSurface:
+    case InvalidCause::kOutOfRange:
+    case InvalidCause::kLowConfidence:
+      return kImplausible;
+    case InvalidCause::kImageUnusable:
+      return kImageUnusable;
+  }
+  return 0;
+}
+
 }  // namespace
 
 WordOrder parse_word_order(std::string_view name) {
@@ -56,13 +73,13 @@ RegisterBlock encode(const RegisterValues& values, WordOrder order) {
   }
   put(block, kFrameCounter, split_words(static_cast<std::uint32_t>(values.frame_id), order));
   block[kStatus] = static_cast<std::uint16_t>(
-      (values.valid ? kValid : 0) | (values.camera_ok ? kCameraOk : 0) |
-      (values.too_little_soil ? kTooLittleSoil : 0) | (values.stale ? kStale : 0) |
-      (values.pipeline_error ? kPipelineError : 0));
+      (values.valid ? kValid : 0) | (values.camera_ok ? kCameraOk : 0) | cause_bits(values.cause) |
+      (values.stale ? kStale : 0) | (values.pipeline_error ? kPipelineError : 0));
   block[kSoilFraction] =
       static_cast<std::uint16_t>(scaled(values.soil_fraction, 10000.0, 0, 10000));
   block[kConfidence] = static_cast<std::uint16_t>(scaled(values.confidence, 1000.0, 0, 1000));
   block[kHeartbeat] = values.heartbeat;
+  block[kInvalidCause] = static_cast<std::uint16_t>(values.cause);
   block[kAgeMs] = static_cast<std::uint16_t>(std::clamp<std::chrono::milliseconds::rep>(
       values.age.count(), 0, std::numeric_limits<std::uint16_t>::max()));
   return block;

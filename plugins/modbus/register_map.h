@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "tilth/messages/ground_distance.h"
+
 namespace tilth::modbus {
 
 // Offsets from base_register. 32-bit values start at even offsets so that a PLC can map
@@ -21,7 +23,8 @@ inline constexpr std::size_t kSoilFraction = 7;          // 0..10000 = 0..100.00
 inline constexpr std::size_t kConfidence = 8;            // 0..1000 = 0..1
 inline constexpr std::size_t kHeartbeat = 9;             // wraps at 65535
 inline constexpr std::size_t kAgeMs = 10;                // saturates at 65535
-inline constexpr std::size_t kRegisterCount = 11;
+inline constexpr std::size_t kInvalidCause = 11;         // tilth::InvalidCause, 0 = valid
+inline constexpr std::size_t kRegisterCount = 12;
 
 enum StatusBit : std::uint16_t {
   kValid = 1u << 0,
@@ -29,6 +32,8 @@ enum StatusBit : std::uint16_t {
   kTooLittleSoil = 1u << 2,
   kStale = 1u << 3,
   kPipelineError = 1u << 4,
+  kImplausible = 1u << 5,    // not one surface, out of the rig's range, or low confidence
+  kImageUnusable = 1u << 6,  // the colour image carries no information
 };
 
 // Which of the two 16-bit words of a 32-bit value comes first (at the lower address).
@@ -42,7 +47,7 @@ WordOrder parse_word_order(std::string_view name);
 struct RegisterValues {
   bool valid = false;
   bool camera_ok = false;
-  bool too_little_soil = false;
+  InvalidCause cause = InvalidCause::kNone;  // of the measurement shown
   bool stale = true;
   bool pipeline_error = false;
   double distance_mm = 0.0;  // published only while valid

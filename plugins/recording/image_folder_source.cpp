@@ -48,6 +48,7 @@ class ImageFolderSource final : public Source {
   explicit ImageFolderSource(const StageContext& context)
       : folder_(context.params.path("path")),
         recording_(read_recording_json(folder_)),
+        rig_(std::make_shared<const RigCalibration>(recording_.calibration)),
         frames_(read_frames_csv(folder_ / "frames.csv")),
         host_timestamps_(recorded_host_timestamps(folder_, frames_)),
         host_time_(context.params),
@@ -142,6 +143,7 @@ class ImageFolderSource final : public Source {
     RawTofFrame raw;
     raw.gray = std::move(images.depth);
     raw.device_timestamp_ns = entry.depth_timestamp_ns;
+    raw.rig = rig_;
     frame.emit(kRawPort, std::move(raw));
     ColorImage color;
     color.pixels = std::move(images.color);
@@ -156,6 +158,7 @@ class ImageFolderSource final : public Source {
 
   const fs::path folder_;
   const RecordingJson recording_;
+  const std::shared_ptr<const RigCalibration> rig_;  // the frames carry it
   const std::vector<FrameEntry> frames_;
   const std::vector<std::int64_t> host_timestamps_;  // one per frame; empty: not recorded
   const ReplayHostTime host_time_;

@@ -19,7 +19,7 @@
 // behind it is occluded. Each pass projects the depth pixels row by row (see Scratch).
 //
 //   {"type": "registration.projective",
-//    "params": {"calibration": "rig.calib.json", "occlusion_tolerance_mm": 10,
+//    "params": {"occlusion_tolerance_mm": 10,
 //               "interpolation": "nearest"}}
 #include "projective.h"
 
@@ -35,6 +35,7 @@
 #include "depth_to_color.h"
 #include "row_kernels.h"
 #include "tilth/error.h"
+#include "tilth/frame_calibration.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
@@ -235,48 +236,55 @@ void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, con
   }
 }
 
+// What registering a frame needs from its calibration.
+struct Geometry {
+  std::string origin;  // the calibration's, for messages
+  DepthToColor map;
+  OcclusionCells cells;
+};
+
 class ProjectiveRegistration final : public Transform {
  public:
   explicit ProjectiveRegistration(const StageContext& context)
-      : ProjectiveRegistration(context, context.params.path("calibration").string()) {}
+      : calibration_(context.params, context.log,
+                     [&kernels = row_kernels(context.params.string("instruction_set"))](
+                         const RigCalibration& rig) {
+                       return Geometry{rig.origin, DepthToColor(rig, rig.origin, kernels),
+                                       OcclusionCells(rig)};
+                     }),
+        occlusion_tolerance_mm_(
+            static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
+        bilinear_(context.params.string("interpolation") == "bilinear") {}
 
   void process(Frame& frame) override {
-    const cv::Mat& depth = frame.input<DepthImage>(0).mm;
+    const DepthImage& depth = frame.input<DepthImage>(0);
     const ColorImage& color = frame.input<ColorImage>(1);
-    check(depth, color);
+    const auto used = calibration_.for_frame(depth.rig);
+    const Geometry& geometry = used->derived;
+    check(geometry, depth.mm, color);
 
+    const DepthToColor& map = geometry.map;
     auto out = outputs_.acquire();
-    reuse_or_create(out->bgr, map_.depth_height(), map_.depth_width(), CV_8UC3);
-    reuse_or_create(out->status, map_.depth_height(), map_.depth_width(), CV_8UC1);
+    reuse_or_create(out->bgr, map.depth_height(), map.depth_width(), CV_8UC3);
+    reuse_or_create(out->status, map.depth_height(), map.depth_width(), CV_8UC1);
     const auto scratch = scratch_.acquire();
     if (bilinear_) {
-      register_bilinear(depth, color, *scratch, *out);
+      register_bilinear(geometry, depth.mm, color, *scratch, *out);
     } else {
-      register_nearest(map_, cells_, depth, nearest_pixels(color.pixels, color.format),
+      register_nearest(map, geometry.cells, depth.mm, nearest_pixels(color.pixels, color.format),
                        occlusion_tolerance_mm_, *scratch, *out);
     }
     frame.set_output(0, std::move(out));
   }
 
  private:
-  ProjectiveRegistration(const StageContext& context, std::string file)
-      : ProjectiveRegistration(context, file, load_calibration(file)) {}
-  ProjectiveRegistration(const StageContext& context, const std::string& file,
-                         const RigCalibration& rig)
-      : file_(file),
-        map_(rig, file, row_kernels(context.params.string("instruction_set"))),
-        cells_(rig),
-        occlusion_tolerance_mm_(
-            static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
-        bilinear_(context.params.string("interpolation") == "bilinear") {}
-
   // Bilinear sampling blends demosaiced pixels. OpenCV names a mosaic by its second
   // row's second and third pixels, one pixel off the usual naming by the top-left tile.
-  void register_bilinear(const cv::Mat& depth, const ColorImage& color, Scratch& scratch,
-                         RegisteredColor& out) const {
+  void register_bilinear(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color,
+                         Scratch& scratch, RegisteredColor& out) const {
     const auto run = [&](const auto& sampler) {
-      registration::register_bilinear(map_, cells_, depth, sampler, occlusion_tolerance_mm_,
-                                      scratch, out);
+      registration::register_bilinear(geometry.map, geometry.cells, depth, sampler,
+                                      occlusion_tolerance_mm_, scratch, out);
     };
     const auto demosaiced = [&](int opencv_code) {
       cv::cvtColor(color.pixels, scratch.demosaiced, opencv_code);
@@ -300,14 +308,15 @@ class ProjectiveRegistration final : public Transform {
     }
   }
 
-  void check(const cv::Mat& depth, const ColorImage& color) const {
+  static void check(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color) {
+    const DepthToColor& map = geometry.map;
     if (depth.type() != CV_32FC1) {
       throw Error("depth image has pixel type " + cv::typeToString(depth.type()) +
                   "; expected CV_32FC1 (mm)");
     }
-    if (depth.cols != map_.depth_width() || depth.rows != map_.depth_height()) {
+    if (depth.cols != map.depth_width() || depth.rows != map.depth_height()) {
       throw Error("depth image is " + size_text(depth.cols, depth.rows) + " but the calibration " +
-                  file_ + " is for " + size_text(map_.depth_width(), map_.depth_height()));
+                  geometry.origin + " is for " + size_text(map.depth_width(), map.depth_height()));
     }
     const int expected_type = CV_8UC(channels(color.format));
     if (color.pixels.type() != expected_type) {
@@ -315,16 +324,14 @@ class ProjectiveRegistration final : public Transform {
                   cv::typeToString(color.pixels.type()) + "; expected " +
                   cv::typeToString(expected_type));
     }
-    if (color.pixels.cols != map_.color_width() || color.pixels.rows != map_.color_height()) {
+    if (color.pixels.cols != map.color_width() || color.pixels.rows != map.color_height()) {
       throw Error("colour image is " + size_text(color.pixels.cols, color.pixels.rows) +
-                  " but the calibration " + file_ + " is for " +
-                  size_text(map_.color_width(), map_.color_height()));
+                  " but the calibration " + geometry.origin + " is for " +
+                  size_text(map.color_width(), map.color_height()));
     }
   }
 
-  const std::string file_;
-  const DepthToColor map_;
-  const OcclusionCells cells_;
+  FrameCalibration<Geometry> calibration_;
   const float occlusion_tolerance_mm_;
   const bool bilinear_;
   MessagePool<RegisteredColor> outputs_;
@@ -345,7 +352,7 @@ StageDescriptor describe_projective() {
   };
   d.outputs = {PortSpec::of<RegisteredColor>("color", "bgr on the depth grid, status per pixel")};
   d.params = {
-      ParamSpec::path("calibration", std::nullopt).describe("rig calibration file"),
+      frame_calibration_param(),
       ParamSpec::number("occlusion_tolerance_mm", 10.0)
           .range(0, std::nullopt)
           .in_unit("mm")

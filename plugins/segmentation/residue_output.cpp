@@ -130,6 +130,7 @@ void ResidueOutput::emit(Frame& frame, BitMask& residue, const BitMask& unknown,
                          const cv::Mat& depth_mm) {
   auto mask = masks_.acquire();
   auto soil = soil_depths_.acquire();
+  soil->rig = frame.input<DepthImage>(kDepthInput).rig;  // the soil's depth is the depth's
   reuse_or_create(mask->values, depth_mm.rows, depth_mm.cols, CV_8UC1);
   reuse_or_create(soil->mm, depth_mm.rows, depth_mm.cols, CV_32FC1);
 

@@ -1,8 +1,8 @@
 // Writes one CSV row per frame: the frame, its capture times, the ground distance with
-// its validity and quality, the latency from capture, and the ground truth when a
-// truth input is connected. Every row is flushed, so a killed process loses at most the
-// row being written. With rotation by size or age, rows go on in numbered files
-// (run.csv, run.1.csv, run.2.csv, ...), each starting with the header (docs/sinks.md).
+// its validity, the cause when invalid, its quality, the latency from capture, and the ground truth
+// when a truth input is connected. Every row is flushed, so a killed process loses at most the row
+// being written. With rotation by size or age, rows go on in numbered files (run.csv, run.1.csv,
+// run.2.csv, ...), each starting with the header (docs/sinks.md).
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -21,8 +21,8 @@ namespace tilth::sinks {
 namespace {
 
 constexpr std::string_view kHeader =
-    "index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,soil_fraction,soil_pixels,"
-    "spread_mm,confidence,latency_ms,truth_mm\n";
+    "index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
+    "soil_pixels,spread_mm,confidence,latency_ms,truth_mm\n";
 
 // File `number` of a rotated series: the path itself, then "<stem>.<number><extension>".
 std::filesystem::path numbered(const std::filesystem::path& path, std::uint64_t number) {
@@ -67,13 +67,14 @@ class Csv final : public Sink {
       if (known.distance_mm) truth = format("%.3f", *known.distance_mm);
     }
     const std::string row =
-        format("%llu,%lld,%lld,%.3f,%d,%.4f,%lld,%.3f,%.3f,%.3f,",
+        format("%llu,%lld,%lld,%.3f,%d,%s,%.4f,%lld,%.3f,%.3f,%.3f,",
                static_cast<unsigned long long>(info.frame_id),
                static_cast<long long>(info.device_timestamp_ns),
                static_cast<long long>(info.host_timestamp_ns),
                distance.valid ? distance.distance_mm : std::nan(""), distance.valid ? 1 : 0,
-               distance.soil_fraction, static_cast<long long>(distance.soil_pixels),
-               distance.spread_mm, distance.confidence, latency_ms) +
+               distance.valid ? "" : to_string(distance.cause).data(), distance.soil_fraction,
+               static_cast<long long>(distance.soil_pixels), distance.spread_mm,
+               distance.confidence, latency_ms) +
         truth + "\n";
     if (file_ != nullptr && full_before(row)) {
       ++number_;

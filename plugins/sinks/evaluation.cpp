@@ -145,6 +145,7 @@ class Evaluation final : public Sink {
     line["measured"] = true;
     line["distance_mm"] = distance.valid ? json(distance.distance_mm) : json();
     line["valid"] = distance.valid;
+    if (!distance.valid) line["cause"] = to_string(distance.cause);
     line["invalid_reason"] = distance.invalid_reason;
     line["soil_fraction"] = distance.soil_fraction;
     line["confidence"] = distance.confidence;

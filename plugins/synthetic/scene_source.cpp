@@ -71,6 +71,7 @@ class SceneSource final : public Source {
 
   explicit SceneSource(const StageContext& context)
       : rig_(load_calibration(context.params.path("calibration"))),
+        carried_rig_(std::make_shared<const RigCalibration>(rig_)),
         preset_(scene_preset(context.params.string("preset"))),
         seed_(static_cast<std::uint64_t>(context.params.integer("seed"))),
         frames_(context.params.integer("frames") > 0 ? context.params.integer("frames")
@@ -116,6 +117,7 @@ class SceneSource final : public Source {
         static_cast<std::int64_t>(static_cast<double>(index_) * 1e9 / kSimulatedCameraFps);
     RawTofFrame raw = tof_frame(rng);
     raw.device_timestamp_ns = device_ns;
+    raw.rig = carried_rig_;
     ColorImage color = color_frame(rng);
     color.device_timestamp_ns = device_ns + kColorLagNs;
     GroundTruth truth;
@@ -269,6 +271,7 @@ class SceneSource final : public Source {
   }
 
   const RigCalibration rig_;
+  const std::shared_ptr<const RigCalibration> carried_rig_;  // the frames carry it
   ScenePreset preset_;
   const std::uint64_t seed_;
   const std::int64_t frames_;

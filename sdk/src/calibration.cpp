@@ -156,6 +156,7 @@ RigCalibration parse_calibration(const json& document, const std::string& origin
     root.fail("/format", "\"" + std::string(RigCalibration::kFormat) + "\"", format);
   }
   RigCalibration rig;
+  rig.origin = origin;
 
   const Reader depth = root.child("depth_camera");
   depth.only_keys({"model", "width", "height", "fx", "fy", "cx", "cy", "distortion",

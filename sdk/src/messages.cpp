@@ -97,6 +97,32 @@ std::string ResidueMask::summary() const {
   return "mask " + size_of(values) + ", " + std::to_string(residue) + " residue px";
 }
 
+std::string_view to_string(InvalidCause cause) {
+  switch (cause) {
+    case InvalidCause::kNone:
+      return "none";
+    case InvalidCause::kTooLittleSoil:
+      return "too_little_soil";
+    case InvalidCause::kNotOneSurface:
+      return "not_one_surface";
+    case InvalidCause::kOutOfRange:
+      return "out_of_range";
+    case InvalidCause::kLowConfidence:
+      return "low_confidence";
+    case InvalidCause::kImageUnusable:
+      return "image_unusable";
+  }
+  return "unknown";
+}
+
+void GroundDistance::invalidate(InvalidCause why, std::string reason) {
+  valid = false;
+  cause = why;
+  invalid_reason = std::move(reason);
+  distance_mm = 0.0;
+  confidence = 0.0;
+}
+
 std::string GroundDistance::summary() const {
   std::ostringstream out;
   out.setf(std::ios::fixed);

@@ -124,8 +124,10 @@ std::string ParamSpec::check(const nlohmann::json& value) const {
     case ParamType::kString:
       return value.is_string() ? "" : "a string";
     case ParamType::kPath:
-      return value.is_string() && !value.get<std::string>().empty() ? ""
-                                                                    : "a file or directory path";
+      // An empty path is "none", for a parameter whose default is none.
+      return value.is_string() && (!value.get<std::string>().empty() || default_value == "")
+                 ? ""
+                 : "a file or directory path";
     case ParamType::kChoice:
       if (value.is_string()) {
         for (const auto& choice : choices) {

@@ -20,8 +20,10 @@ namespace fs = std::filesystem;
 const fs::path kPaperRig = fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
 
 StageContext context_for(const fs::path& calibration) {
-  return {
-      "depth", Params(nlohmann::json{{"calibration", calibration.string()}}), Logger("depth"), {}};
+  return {"depth",
+          Params(nlohmann::json{{"calibration", calibration.string()}, {"saturated_gray", 65535}}),
+          Logger("depth"),
+          {}};
 }
 
 TEST(DepthPlugin, TheLibraryProvidesTheProjectionStage) {

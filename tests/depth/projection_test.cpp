@@ -16,8 +16,10 @@
 #include <opencv2/core.hpp>
 
 #include "projection.h"
+#include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
+#include "tilth/log.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/raw_tof_frame.h"
 
@@ -53,9 +55,13 @@ class CalibrationFile {
   fs::path path_;
 };
 
-std::unique_ptr<Transform> make_projection(const fs::path& calibration) {
+std::unique_ptr<Transform> make_projection(const fs::path& calibration,
+                                           int saturated_gray = 65535) {
   const StageContext context{
-      "projection", Params(json{{"calibration", calibration.string()}}), Logger("projection"), {}};
+      "projection",
+      Params(json{{"calibration", calibration.string()}, {"saturated_gray", saturated_gray}}),
+      Logger("projection"),
+      {}};
   std::unique_ptr<Stage> stage = describe_projection().create(context);
   auto* transform = dynamic_cast<Transform*>(stage.get());
   if (transform == nullptr) throw std::logic_error("depth.projection is not a transform");
@@ -105,7 +111,7 @@ TEST(DepthProjection, Eq1AtTheCentreAndTheFourCorners) {
   const auto stage = make_projection(kPaperRig);
   // About 518 mm of soil (the paper's mounting height) and a spread of other values.
   const std::vector<Pixel> pixels = {
-      {313, 240, 23666}, {0, 0, 27000}, {639, 0, 30000}, {0, 479, 45000}, {639, 479, 65535}};
+      {313, 240, 23666}, {0, 0, 27000}, {639, 0, 30000}, {0, 479, 45000}, {639, 479, 65534}};
   RawTofFrame raw = uniform_frame(20000);
   for (const auto& p : pixels) raw.gray.at<std::uint16_t>(p.v, p.u) = p.gray;
   const auto depth = project(*stage, raw);
@@ -310,6 +316,86 @@ TEST(DepthProjection, OutputBuffersAreReusedInSteadyState) {
   EXPECT_NEAR(depth->mm.at<float>(240, 313), static_cast<double>(eq1(30000, 313, 240)), kMm);
 }
 
+// A saturated ToF image once gave 1440.7 mm valid (issue #14): the sensor's ceiling says
+// nothing about where the surface is.
+TEST(DepthProjection, GrayAtOrAboveTheSaturationIsNoDepth) {
+  const auto stage = make_projection(kPaperRig);
+  RawTofFrame raw = uniform_frame(65535);
+  raw.gray.at<std::uint16_t>(240, 313) = 65534;
+  const auto depth = project(*stage, std::move(raw));
+  EXPECT_TRUE(std::isnan(depth->mm.at<float>(0, 0)));
+  EXPECT_NEAR(depth->mm.at<float>(240, 313), static_cast<double>(eq1(65534, 313, 240)), kMm);
+
+  const auto lower = make_projection(kPaperRig, 60000);
+  RawTofFrame below = uniform_frame(60000);
+  below.gray.at<std::uint16_t>(240, 313) = 59999;
+  const auto clipped = project(*lower, std::move(below));
+  EXPECT_TRUE(std::isnan(clipped->mm.at<float>(0, 0)));
+  EXPECT_NEAR(clipped->mm.at<float>(240, 313), static_cast<double>(eq1(59999, 313, 240)), kMm);
+}
+
+class LogCapture {
+ public:
+  LogCapture()
+      : previous_(set_log_handler([this](LogLevel level, std::string_view, std::string_view text) {
+          if (level == LogLevel::kWarning) warnings.emplace_back(text);
+        })) {}
+  ~LogCapture() { set_log_handler(previous_); }
+
+  std::vector<std::string> warnings;
+
+ private:
+  LogHandler previous_;
+};
+
+// Without a file named, the stage uses the calibration the frame carries, and its depth
+// image carries it on.
+TEST(DepthProjection, AFrameCarriesItsCalibration) {
+  const auto stage = make_projection("");
+  RawTofFrame raw = uniform_frame(23666);
+  raw.rig = std::make_shared<const RigCalibration>(load_calibration(kPaperRig));
+  const auto rig = raw.rig;
+  const auto depth = project(*stage, std::move(raw));
+  EXPECT_NEAR(depth->mm.at<float>(0, 639), static_cast<double>(eq1(23666, 639, 0)), kMm);
+  EXPECT_EQ(depth->rig, rig);
+}
+
+TEST(DepthProjection, NoCalibrationAnywhereIsAnErrorSayingSo) {
+  const auto stage = make_projection("");
+  try {
+    project(*stage, uniform_frame(23666));
+    FAIL() << "projected";
+  } catch (const Error& error) {
+    EXPECT_STREQ(error.what(),
+                 "the frame carries no rig calibration and parameter 'calibration' names none: "
+                 "name the rig's calibration file, or use a source whose frames carry one (a "
+                 "recording, the simulator, or a camera source given its 'calibration')");
+  }
+}
+
+// A file named overrides the frame's calibration, never silently: one warning per
+// calibration carried, naming what differs.
+TEST(DepthProjection, ANamedFileOverridesTheFramesCalibrationLoudly) {
+  json other = paper_rig();
+  other["depth_camera"]["gray_to_mm"] = 0.025;
+  const CalibrationFile carried_file(other);
+  const auto carried =
+      std::make_shared<const RigCalibration>(load_calibration(carried_file.path()));
+  const auto stage = make_projection(kPaperRig);
+  LogCapture log;
+  for (int frame = 0; frame < 3; ++frame) {
+    RawTofFrame raw = uniform_frame(23666);
+    raw.rig = carried;
+    const auto depth = project(*stage, std::move(raw));
+    EXPECT_NEAR(depth->mm.at<float>(0, 0), static_cast<double>(eq1(23666, 0, 0)), kMm);
+  }
+  EXPECT_EQ(log.warnings,
+            std::vector<std::string>{
+                "parameter 'calibration' (" + kPaperRig.string() +
+                ") overrides the calibration the frames carry (" + carried_file.path().string() +
+                "), which differs: /depth_camera/gray_to_mm: 0.0229 against 0.025"});
+}
+
 TEST(DepthProjection, DescriptorDeclaresTheContract) {
   const StageDescriptor d = describe_projection();
   EXPECT_EQ(d.type, "depth.projection");
@@ -321,7 +407,10 @@ TEST(DepthProjection, DescriptorDeclaresTheContract) {
   EXPECT_EQ(d.outputs[0].type, DepthImage::kTypeName);
   ASSERT_NE(d.param("calibration"), nullptr);
   EXPECT_EQ(d.param("calibration")->type, ParamType::kPath);
-  EXPECT_TRUE(d.param("calibration")->required());
+  EXPECT_FALSE(d.param("calibration")->required());  // "": the frames' own
+  EXPECT_EQ(d.param("calibration")->default_value, "");
+  ASSERT_NE(d.param("saturated_gray"), nullptr);
+  EXPECT_EQ(d.param("saturated_gray")->default_value, 65535);
   EXPECT_EQ(d.concurrency, Concurrency::kParallel);
 }
 

@@ -44,7 +44,8 @@ class DistanceSequence final : public tilth::Source {
     distance.distance_mm =
         std::round((start_mm_ + step_mm_ * static_cast<double>(index_)) * 100.0) / 100.0;
     distance.valid = invalid_every_ == 0 || (index_ + 1) % invalid_every_ != 0;
-    if (!distance.valid) distance.invalid_reason = "too little visible soil";
+    if (!distance.valid)
+      distance.invalidate(tilth::InvalidCause::kTooLittleSoil, "too little visible soil");
     distance.soil_fraction = static_cast<double>(index_ % 97) / 100.0 + 0.0012;
     distance.soil_pixels = 1000 + index_;
     distance.spread_mm = 1.5;

@@ -32,12 +32,12 @@ TEST(RegisterMap, DistanceInBothWordOrders) {
   values.heartbeat = 4242;
   values.age = milliseconds(37);
   // 518.23 mm = 51823 hundredths = 0x0000CA6F; 518.23f = 0x44018EB8.
-  EXPECT_EQ(
-      encode(values, WordOrder::kHighFirst),
-      (RegisterBlock{0x0000, 0xCA6F, 0x4401, 0x8EB8, 0x0001, 0x1170, 0x0003, 4321, 877, 4242, 37}));
-  EXPECT_EQ(
-      encode(values, WordOrder::kLowFirst),
-      (RegisterBlock{0xCA6F, 0x0000, 0x8EB8, 0x4401, 0x1170, 0x0001, 0x0003, 4321, 877, 4242, 37}));
+  EXPECT_EQ(encode(values, WordOrder::kHighFirst),
+            (RegisterBlock{0x0000, 0xCA6F, 0x4401, 0x8EB8, 0x0001, 0x1170, 0x0003, 4321, 877, 4242,
+                           37, 0}));
+  EXPECT_EQ(encode(values, WordOrder::kLowFirst),
+            (RegisterBlock{0xCA6F, 0x0000, 0x8EB8, 0x4401, 0x1170, 0x0001, 0x0003, 4321, 877, 4242,
+                           37, 0}));
 }
 
 TEST(RegisterMap, NegativeAndSaturatedDistances) {
@@ -59,7 +59,7 @@ TEST(RegisterMap, NotValidPublishesNoDistance) {
   values.valid = false;
   values.stale = false;
   values.camera_ok = true;
-  values.too_little_soil = true;
+  values.cause = InvalidCause::kTooLittleSoil;
   values.distance_mm = 518.23;
   values.soil_fraction = 0.031;
   const RegisterBlock block = encode(values, WordOrder::kHighFirst);
@@ -69,6 +69,32 @@ TEST(RegisterMap, NotValidPublishesNoDistance) {
   EXPECT_EQ(block[kDistanceMm + 1], 0);
   EXPECT_EQ(block[kStatus], kCameraOk | kTooLittleSoil);  // 0x0006
   EXPECT_EQ(block[kSoilFraction], 310);
+  EXPECT_EQ(block[kInvalidCause], 1);
+}
+
+// Each cause sets its status bit and its number (docs/modbus.md), and clears valid's
+// distance registers.
+TEST(RegisterMap, EachInvalidCauseHasItsBitAndNumber) {
+  struct Expected {
+    InvalidCause cause;
+    std::uint16_t status;
+    std::uint16_t number;
+  };
+  for (const Expected& expected : {Expected{InvalidCause::kTooLittleSoil, 0x0006, 1},
+                                   Expected{InvalidCause::kNotOneSurface, 0x0022, 2},
+                                   Expected{InvalidCause::kOutOfRange, 0x0022, 3},
+                                   Expected{InvalidCause::kLowConfidence, 0x0022, 4},
+                                   Expected{InvalidCause::kImageUnusable, 0x0042, 5}}) {
+    RegisterValues values;
+    values.stale = false;
+    values.camera_ok = true;
+    values.cause = expected.cause;
+    values.distance_mm = 1448.81;
+    const RegisterBlock block = encode(values, WordOrder::kHighFirst);
+    EXPECT_EQ(block[kStatus], expected.status) << to_string(expected.cause);
+    EXPECT_EQ(block[kInvalidCause], expected.number) << to_string(expected.cause);
+    EXPECT_EQ(block[kDistanceMm], 0) << to_string(expected.cause);
+  }
 }
 
 TEST(RegisterMap, StatusBitsEach) {
@@ -123,11 +149,12 @@ TEST(RegisterMap, WordOrderNames) {
 
 class LatestMeasurementTest : public ::testing::Test {
  protected:
-  static GroundDistance measured(double distance_mm, bool valid, std::string reason = "") {
+  static GroundDistance measured(double distance_mm, bool valid,
+                                 InvalidCause cause = InvalidCause::kNone) {
     GroundDistance distance;
     distance.distance_mm = distance_mm;
     distance.valid = valid;
-    distance.invalid_reason = std::move(reason);
+    distance.cause = cause;
     distance.soil_fraction = 0.5;
     distance.confidence = 0.9;
     return distance;
@@ -197,14 +224,15 @@ TEST_F(LatestMeasurementTest, ALostCameraClearsCameraOkAndValid) {
             kValid | kCameraOk);
 }
 
-TEST_F(LatestMeasurementTest, TooLittleSoilIsTheInvalidReasonAboutSoil) {
-  latest_.update(3, measured(0.0, false, "too little visible soil (2 %)"), t0_, milliseconds(0));
+TEST_F(LatestMeasurementTest, TheCauseOfTheNewestMeasurementIsShown) {
+  latest_.update(3, measured(0.0, false, InvalidCause::kTooLittleSoil), t0_, milliseconds(0));
   EXPECT_EQ(encode(latest_.values_at(t0_), WordOrder::kHighFirst)[kStatus],
             kCameraOk | kTooLittleSoil);
-  latest_.update(4, measured(0.0, false, "Too Little SOIL"), t0_, milliseconds(0));
-  EXPECT_TRUE(latest_.values_at(t0_).too_little_soil);
-  latest_.update(5, measured(0.0, false, "depth image empty"), t0_, milliseconds(0));
-  EXPECT_EQ(encode(latest_.values_at(t0_), WordOrder::kHighFirst)[kStatus], kCameraOk);
+  latest_.update(4, measured(1448.81, false, InvalidCause::kOutOfRange), t0_, milliseconds(0));
+  EXPECT_EQ(encode(latest_.values_at(t0_), WordOrder::kHighFirst)[kStatus],
+            kCameraOk | kImplausible);
+  latest_.update(5, measured(518.0, true), t0_, milliseconds(0));
+  EXPECT_EQ(latest_.values_at(t0_).cause, InvalidCause::kNone);
 }
 
 }  // namespace

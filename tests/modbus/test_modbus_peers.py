@@ -30,9 +30,10 @@ MBPOLL = os.environ["MBPOLL"]
 PLC_SERVER = os.environ["PLC_SERVER"]
 
 # The register map (docs/modbus.md), offsets from base_register.
-DISTANCE_HUNDREDTHS, DISTANCE_FLOAT, FRAME, STATUS, SOIL, CONFIDENCE, HEARTBEAT, AGE = (
-    0, 2, 4, 6, 7, 8, 9, 10)
-COUNT = 11
+DISTANCE_HUNDREDTHS, DISTANCE_FLOAT, FRAME, STATUS, SOIL, CONFIDENCE, HEARTBEAT, AGE, CAUSE = (
+    0, 2, 4, 6, 7, 8, 9, 10, 11)
+COUNT = 12
+CAUSE_TOO_LITTLE_SOIL = 1
 VALID, CAMERA_OK, TOO_LITTLE_SOIL, STALE, PIPELINE_ERROR = 1, 2, 4, 8, 16
 
 STALE_TIMEOUT_MS = 200
@@ -118,6 +119,7 @@ def decode(registers, word_order="big"):
         "confidence": registers[CONFIDENCE],
         "heartbeat": registers[HEARTBEAT],
         "age": registers[AGE],
+        "cause": registers[CAUSE],
     }
 
 
@@ -132,6 +134,7 @@ def expected(row):
         "status": (VALID if valid else TOO_LITTLE_SOIL) | CAMERA_OK,
         "soil": round(float(row["soil_fraction"]) * 10000),
         "confidence": round(float(row["confidence"]) * 1000),
+        "cause": 0 if valid else CAUSE_TOO_LITTLE_SOIL,
     }
 
 
@@ -411,7 +414,7 @@ class ServerMode(unittest.TestCase):
 class ClientMode(unittest.TestCase):
     """Tilth writes into a stand-in PLC that comes up late and restarts."""
 
-    BASE = 100  # registers 100..110, low word first
+    BASE = 100  # registers 100..111, low word first
 
     def start_plc(self):
         plc = subprocess.Popen([sys.executable, PLC_SERVER, str(self.port)],
@@ -477,7 +480,7 @@ class ClientMode(unittest.TestCase):
             where = "127.0.0.1:%d" % self.port
             self.assertIn("cannot connect to the PLC at %s: Connection refused; retrying" % where,
                           log)
-            self.assertEqual(log.count("connected to the PLC at %s; writing registers 100..110"
+            self.assertEqual(log.count("connected to the PLC at %s; writing registers 100..111"
                                        % where), 2, log)
             self.assertIn("connection to the PLC at %s lost" % where, log)
 
@@ -497,7 +500,7 @@ class ClientMode(unittest.TestCase):
             plc.wait()
         self.assertEqual(code, 0, log)
         where = "127.0.0.1:%d" % self.port
-        self.assertEqual(log.count("the PLC at %s refused the write to registers 195..205: "
+        self.assertEqual(log.count("the PLC at %s refused the write to registers 195..206: "
                                    "Illegal data address; writing on" % where), 1, log)
         self.assertEqual(log.count("connected to the PLC at %s" % where), 1, log)
         self.assertNotIn("lost", log)

@@ -98,11 +98,12 @@ std::unique_ptr<Transform> make_registration(const fs::path& calibration,
   return std::unique_ptr<Transform>(transform);
 }
 
-std::shared_ptr<const RegisteredColor> register_color(Transform& stage, const cv::Mat& depth_mm,
-                                                      const cv::Mat& pixels,
-                                                      PixelFormat format = PixelFormat::kBgr8) {
+std::shared_ptr<const RegisteredColor> register_color(
+    Transform& stage, const cv::Mat& depth_mm, const cv::Mat& pixels,
+    PixelFormat format = PixelFormat::kBgr8, std::shared_ptr<const RigCalibration> rig = nullptr) {
   DepthImage depth;
   depth.mm = depth_mm;
+  depth.rig = std::move(rig);
   ColorImage color;
   color.pixels = pixels;
   color.format = format;
@@ -340,6 +341,24 @@ TEST(ProjectiveRegistration, PixelsOutsideTheColourImageAreFlaggedAndBlack) {
   expect_agreement(a, 60000);
   EXPECT_GT(cv::countNonZero(out->status == RegisteredColor::kOutsideColor), 100000);
   EXPECT_EQ(cv::countNonZero(out->status == RegisteredColor::kNoDepth), 100);
+}
+
+// Without a file named, the stage registers with the calibration the depth image carries:
+// a rig turned and moved registers exactly as with its file named.
+TEST(ProjectiveRegistration, TheDepthsCarriedCalibrationIsUsed) {
+  json document = paper_rig();
+  document["depth_to_color"]["T_mm"] = {-38.0, 12.0, 6.0};
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
+  const auto named = register_color(*make_registration(file.path()), depth, coordinate_image());
+  const auto carried =
+      register_color(*make_registration(""), depth, coordinate_image(), PixelFormat::kBgr8,
+                     std::make_shared<const RigCalibration>(load_calibration(file.path())));
+  EXPECT_EQ(cv::norm(named->bgr, carried->bgr, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(named->status, carried->status, cv::NORM_INF), 0.0);
+  const auto paper = register_color(*make_registration(kPaperRig), depth, coordinate_image());
+  EXPECT_GT(cv::norm(paper->bgr, carried->bgr, cv::NORM_INF), 0.0);  // the rig matters
 }
 
 TEST(ProjectiveRegistration, PointsBeyondTheDistortionsFoldAreOutsideNotFoldedIn) {
@@ -863,7 +882,7 @@ TEST(ProjectiveRegistration, DescriptorDeclaresTheContract) {
   ASSERT_EQ(d.outputs.size(), 1u);
   EXPECT_EQ(d.outputs[0].type, RegisteredColor::kTypeName);
   ASSERT_NE(d.param("calibration"), nullptr);
-  EXPECT_TRUE(d.param("calibration")->required());
+  EXPECT_FALSE(d.param("calibration")->required());  // "": the frames' own
   ASSERT_NE(d.param("occlusion_tolerance_mm"), nullptr);
   EXPECT_EQ(d.param("occlusion_tolerance_mm")->default_value, 10.0);
   ASSERT_NE(d.param("interpolation"), nullptr);

@@ -3,6 +3,7 @@
 // plugins (which link the stage objects directly instead of loading the plugin).
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -46,15 +47,18 @@ class TransformHarness {
     if (transform_ == nullptr) throw Error(descriptor_.type + " is not a transform");
   }
 
-  // One frame through the stage; an output it left unset is an empty packet. The packets
+  // One frame through the stage; an input not given (or null) is an empty packet, as an
+  // unconnected optional input is, and so is an output the stage left unset. The packets
   // own the messages: keep them (or copy the message) while reading an output.
   std::vector<Packet> run(std::vector<std::shared_ptr<const Message>> inputs,
                           std::uint64_t frame_id = 0) {
     FrameInfo info;
     info.sequence = frame_id;
     info.frame_id = frame_id;
-    std::vector<Packet> in;
-    for (auto& message : inputs) in.emplace_back(info, std::move(message));
+    std::vector<Packet> in(std::max(inputs.size(), descriptor_.inputs.size()));
+    for (std::size_t port = 0; port < inputs.size(); ++port) {
+      if (inputs[port] != nullptr) in[port] = Packet(info, std::move(inputs[port]));
+    }
     std::vector<Packet> out(descriptor_.outputs.size());
     Frame frame(info, in, out);
     transform_->process(frame);

@@ -13,7 +13,7 @@ import unittest
 TILTH = os.environ["TILTH_BIN"]
 PLUGIN_DIR = os.environ["TILTH_TEST_PLUGIN_DIR"]
 
-HEADER = ("index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,soil_fraction,"
+HEADER = ("index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
           "soil_pixels,spread_mm,confidence,latency_ms,truth_mm")
 FIELDS = HEADER.split(",")
 
@@ -84,6 +84,7 @@ class Rows(unittest.TestCase):
             self.assertEqual(row["distance_mm"], "%.3f" % round(518.23 + 0.37 * i, 2)
                              if valid else "nan")
             self.assertEqual(row["valid"], "1" if valid else "0")
+            self.assertEqual(row["cause"], "" if valid else "too_little_soil")
             self.assertEqual(row["soil_fraction"], "%.4f" % (i / 100 + 0.0012))
             self.assertEqual(row["soil_pixels"], str(1000 + i))
             self.assertEqual(row["spread_mm"], "1.500")

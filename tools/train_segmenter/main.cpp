@@ -26,7 +26,7 @@ using tilth::train_segmenter::Scores;
 using tilth::train_segmenter::TrainingSet;
 
 constexpr const char* kUsage =
-    R"(usage: tilth train-segmenter RECORDING... --calibration FILE --out MODEL [OPTIONS]
+    R"(usage: tilth train-segmenter RECORDING... --out MODEL [OPTIONS]
 
 Trains the pixel classifier of segmentation.pixel_classifier (a random forest over each
 pixel's colour features) on recordings with ground-truth residue masks, scores it on
@@ -36,7 +36,8 @@ Each RECORDING is an image-folder recording (a folder) or an MCAP file. Frames g
 through depth projection and registration as in graphs/measurement-chain.json, so the
 classifier sees the colours the stage will see; frames without a mask are skipped.
 
-  --calibration FILE   the rig calibration the recordings were made with (required)
+  --calibration FILE   a rig calibration overriding the one each recording carries
+                       (a warning names what differs; default: each recording's own)
   --out MODEL          the model file to write (required)
   --test RECORDING     score on this recording instead (repeatable); without --test,
                        every 5th frame of the training recordings is held out
@@ -112,7 +113,6 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (line.positional().empty()) return usage_error("expected at least one RECORDING");
-  if (!line.value("--calibration")) return usage_error("--calibration FILE is required");
   if (!line.value("--out")) return usage_error("--out MODEL is required");
   long samples = 0, seed = 0, trees = 0, depth = 0;
   try {
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
   }
-  const fs::path calibration = *line.value("--calibration");
+  const fs::path calibration = line.value("--calibration").value_or("");
   const fs::path out = *line.value("--out");
   const std::vector<std::string> tests = line.values("--test");
 

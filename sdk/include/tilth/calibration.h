@@ -41,6 +41,7 @@ struct DepthCameraCalibration : CameraIntrinsics {
 struct RigCalibration {
   static constexpr std::string_view kFormat = "tilth-calibration/1";
 
+  std::string origin;  // where it was read: a file's path, or a recording's attachment
   DepthCameraCalibration depth;
   CameraIntrinsics color;
   cv::Matx33d depth_to_color_r = cv::Matx33d::eye();  // P_c = R * P_d + T

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include <opencv2/core/mat.hpp>
@@ -10,6 +11,8 @@
 #include "tilth/message.h"
 
 namespace tilth {
+
+struct RigCalibration;
 
 struct RawTofFrame : MessageOf<RawTofFrame> {
   static constexpr std::string_view kTypeName = "tilth.RawTofFrame";
@@ -20,6 +23,9 @@ struct RawTofFrame : MessageOf<RawTofFrame> {
   // Scan3dCoordinateOffset) when it reports them; they win over the calibration file.
   std::optional<double> scale_mm;
   std::optional<double> offset_mm;
+  // The calibration of the rig that captured the frame, when its source knows it (a
+  // recording's own, the simulator's, a camera source given one): tilth/frame_calibration.h.
+  std::shared_ptr<const RigCalibration> rig;
 
   std::string summary() const override;
 };

@@ -1,0 +1,45 @@
+// The plausibility gates every ground estimator applies, so that no implausible number is
+// ever served as valid: a colour image that carries information, a distance the rig can
+// physically see, soil depths that form one surface, and enough confidence. A gate only
+// ever invalidates a measurement (with its cause and reason); it never changes a number.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/types.hpp>
+
+#include "tilth/messages/ground_distance.h"
+#include "tilth/messages/registered_color.h"
+#include "tilth/param_spec.h"
+#include "tilth/params.h"
+#include "tilth/port_spec.h"
+
+namespace tilth::estimation {
+
+class PlausibilityGates {
+ public:
+  explicit PlausibilityGates(const Params& params);
+
+  // The gates' parameters and optional colour input, for an estimator's descriptor.
+  static std::vector<ParamSpec> params();
+  static PortSpec color_port();
+
+  // Why the registered colour in `roi` cannot tell residue from soil (mostly clipped
+  // white or black, or flat), or nothing when it can.
+  std::optional<std::string> unusable_color(const RegisteredColor& color, cv::Rect roi) const;
+
+  // Invalidates a measured, valid `out` whose distance, spread or confidence is implausible.
+  void check(GroundDistance& out) const;
+
+ private:
+  double min_distance_mm_;
+  double max_distance_mm_;
+  double max_spread_mm_;
+  double min_confidence_;
+  double max_clipped_fraction_;
+  double min_color_contrast_;
+};
+
+}  // namespace tilth::estimation
