@@ -39,14 +39,14 @@ std::string number_text(double x) {
 Bounds focal_length_bounds(int size, const char* side) {
   constexpr double kDegree = 3.14159265358979323846 / 180.0;
   return {size / 2.0 / std::tan(80 * kDegree), size / 2.0 / std::tan(0.5 * kDegree), false,
-          "px: a field of view across the " + std::to_string(size) + "-px " + side +
+          " px: a field of view across the " + std::to_string(size) + "-px " + side +
               " between 1 and 160 degrees"};
 }
 
 // The principal point is where the optical axis meets the sensor: inside the image,
 // whose pixels' centres are 0 .. size - 1 (edges at -0.5 and size - 0.5).
 Bounds principal_point_bounds(int size, const char* side) {
-  return {-0.5, size - 0.5, false, "px: inside the " + std::to_string(size) + "-px " + side};
+  return {-0.5, size - 0.5, false, " px: inside the " + std::to_string(size) + "-px " + side};
 }
 
 // OpenCV's radial terms k1, k2, k3 of lenses up to 120 degrees calibrate to |k| below 1,

@@ -1,6 +1,3 @@
-// nlohmann's parser is iterative and calls back at each key, value and bracket before it
-// goes deeper, so the checks below run before a hostile document can build anything
-// large: a key seen twice, the 65th nested bracket, a number that overflows to infinity.
 #include "tilth/json_input.h"
 
 #include <fstream>
@@ -47,55 +44,72 @@ std::string parse_error_reason(const std::string& what) {
   return colon == std::string::npos ? what : what.substr(colon + 2);
 }
 
-// "number overflow parsing '1e999'" -> "1e999"
-std::string overflowing_number(const std::string& what) {
-  const auto open = what.find('\'');
-  const auto close = what.rfind('\'');
-  return open == std::string::npos || close <= open ? "?" : what.substr(open + 1, close - open - 1);
-}
-
-// Where the parser is: one frame per open object or array, with the key or index of the
-// value being read in it.
-class Position {
+// Builds the document from nlohmann's parser events, checking as it goes. The parser is
+// iterative, so nothing recurses before the 65th nested bracket is refused. Objects are
+// appended to, not searched: each key is checked once against its object's key set,
+// which keeps an ordered_json of n keys O(n log n) where the parser's own builder
+// searches the whole object for each key, O(n^2).
+template <typename Json>
+class Builder {
  public:
-  explicit Position(const std::string& origin) : origin_(origin) {}
+  using number_integer_t = typename Json::number_integer_t;
+  using number_unsigned_t = typename Json::number_unsigned_t;
+  using number_float_t = typename Json::number_float_t;
+  using string_t = typename Json::string_t;
+  using binary_t = typename Json::binary_t;
 
-  template <typename Json>
-  bool on_event(nlohmann::detail::parse_event_t event, const Json& parsed) {
-    using Event = nlohmann::detail::parse_event_t;
-    switch (event) {
-      case Event::object_start:
-      case Event::array_start:
-        if (frames_.size() >= kMaxJsonDepth) {
-          refuse("expected at most " + std::to_string(kMaxJsonDepth) +
-                 " nested arrays and objects, got more");
-        }
-        frames_.push_back({event == Event::array_start, 0, {}, {}});
-        break;
-      case Event::key: {
-        Frame& frame = frames_.back();
-        frame.key = parsed.template get<std::string>();
-        if (!frame.keys.insert(frame.key).second) {
-          refuse("expected each key once in an object, got \"" + frame.key + "\" again");
-        }
-        break;
-      }
-      case Event::object_end:
-      case Event::array_end:
-        frames_.pop_back();
-        next_value();
-        break;
-      case Event::value:
-        next_value();
-        break;
+  Builder(std::string_view text, const std::string& origin) : text_(text), origin_(origin) {}
+
+  bool null() { return add(nullptr) != nullptr; }
+  bool boolean(bool value) { return add(value) != nullptr; }
+  bool number_integer(number_integer_t value) { return add(value) != nullptr; }
+  bool number_unsigned(number_unsigned_t value) { return add(value) != nullptr; }
+  bool number_float(number_float_t value, const string_t&) { return add(value) != nullptr; }
+  bool string(string_t& value) { return add(std::move(value)) != nullptr; }
+  bool binary(binary_t& value) { return add(Json::binary(std::move(value))) != nullptr; }
+  bool start_object(std::size_t) { return open(Json::object(), false); }
+  bool start_array(std::size_t) { return open(Json::array(), true); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+
+  bool key(string_t& key) {
+    Frame& frame = frames_.back();
+    frame.key = key;
+    if (!frame.keys.insert(key).second) {
+      refuse("expected each key once in an object, got \"" + key + "\" again");
     }
     return true;
   }
 
+  bool parse_error(std::size_t position, const std::string& token,
+                   const nlohmann::detail::exception& error) {
+    // The parser's only out_of_range: a number that overflows a double.
+    if (dynamic_cast<const nlohmann::detail::out_of_range*>(&error) != nullptr) {
+      refuse("expected a number within double range (magnitude below 1.8e308), got " + token);
+    }
+    const auto [line, column] = line_and_column(text_, position == 0 ? 0 : position - 1);
+    throw JsonError(origin_, "", line, column, parse_error_reason(error.what()));
+  }
+
+  Json take() { return std::move(document_); }
+
+ private:
+  struct Frame {
+    Json* container;
+    bool array;
+    std::string key;  // of the value being read, in an object
+    std::set<std::string> keys;
+  };
+
+  // Where the next value goes. An array's value being read is its open last element, or,
+  // in the innermost container, the one after its last.
   std::string pointer() const {
     std::string text;
-    for (const Frame& frame : frames_) {
-      text += "/" + (frame.array ? std::to_string(frame.index) : pointer_token(frame.key));
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      const Frame& frame = frames_[i];
+      const bool innermost = i + 1 == frames_.size();
+      text += "/" + (frame.array ? std::to_string(frame.container->size() - (innermost ? 0 : 1))
+                                 : pointer_token(frame.key));
     }
     return text;
   }
@@ -104,39 +118,55 @@ class Position {
     throw JsonError(origin_, pointer(), 0, 0, reason);
   }
 
- private:
-  struct Frame {
-    bool array;
-    std::size_t index;
-    std::string key;
-    std::set<std::string> keys;
-  };
-
-  void next_value() {
-    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  Json* add(Json value) {
+    if (frames_.empty()) {
+      document_ = std::move(value);
+      return &document_;
+    }
+    Frame& frame = frames_.back();
+    if (frame.array) {
+      frame.container->push_back(std::move(value));
+      return &frame.container->back();
+    }
+    auto& object = frame.container->template get_ref<typename Json::object_t&>();
+    if constexpr (std::is_same_v<typename Json::object_t, nlohmann::ordered_json::object_t>) {
+      // Appended, not searched: key() refused a second use of the key.
+      object.Container::emplace_back(frame.key, std::move(value));
+      return &object.back().second;
+    } else {
+      return &object.emplace(frame.key, std::move(value)).first->second;
+    }
   }
 
+  bool open(Json container, bool array) {
+    if (frames_.size() >= kMaxJsonDepth) {
+      refuse("expected at most " + std::to_string(kMaxJsonDepth) +
+             " nested arrays and objects, got more");
+    }
+    Json* opened = add(std::move(container));
+    frames_.push_back({opened, array, {}, {}});
+    return true;
+  }
+
+  bool close() {
+    frames_.pop_back();
+    return true;
+  }
+
+  std::string_view text_;
   const std::string& origin_;
+  Json document_;
+  // The open containers, outermost first. A container's address holds while it is open:
+  // its parent grows only after it closes.
   std::vector<Frame> frames_;
 };
 
 template <typename Json>
 Json parse(std::string_view text, const std::string& origin, JsonSyntax syntax) {
-  Position position(origin);
-  const typename Json::parser_callback_t check =
-      [&position](int, nlohmann::detail::parse_event_t event, Json& parsed) {
-        return position.on_event(event, parsed);
-      };
-  try {
-    return Json::parse(text, check, /*allow_exceptions=*/true, syntax.comments);
-  } catch (const nlohmann::json::parse_error& error) {
-    const auto [line, column] = line_and_column(text, error.byte == 0 ? 0 : error.byte - 1);
-    throw JsonError(origin, "", line, column, parse_error_reason(error.what()));
-  } catch (const nlohmann::json::out_of_range& error) {
-    // 406, the only one the parser throws: a number that overflows a double.
-    position.refuse("expected a number within double range (magnitude below 1.8e308), got " +
-                    overflowing_number(error.what()));
-  }
+  Builder<Json> builder(text, origin);
+  Json::sax_parse(text, &builder, nlohmann::json::input_format_t::json, /*strict=*/true,
+                  syntax.comments);
+  return builder.take();
 }
 
 std::string file_kind(std::filesystem::file_type type) {

@@ -160,10 +160,10 @@ TEST(Calibration, ValuesNoRealRigHasAreRefused) {
             "ToF camera's housing, got 1000000.0");
   // 1250 px is a 54 degree view across the colour camera's 1280 px; 5 px would be 179.
   EXPECT_EQ(refused("color_camera", "fx", 5),
-            "rig.json:/color_camera/fx: expected a number in [112.838, 73336.3] px: a field of "
+            "rig.json:/color_camera/fx: expected a number in [112.849, 73336.7] px: a field of "
             "view across the 1280-px width between 1 and 160 degrees, got 5");
   EXPECT_EQ(refused("depth_camera", "fy", 4.8),  // the lens's focal length in mm
-            "rig.json:/depth_camera/fy: expected a number in [42.3185, 27501.1] px: a field of "
+            "rig.json:/depth_camera/fy: expected a number in [42.3185, 27501.3] px: a field of "
             "view across the 480-px height between 1 and 160 degrees, got 4.8");
   EXPECT_EQ(refused("color_camera", "cx", 1280),
             "rig.json:/color_camera/cx: expected a number in [-0.5, 1279.5] px: inside the 1280-px "
