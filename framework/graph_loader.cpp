@@ -10,13 +10,12 @@
 #include "framework/graph_loader.h"
 
 #include <algorithm>
-#include <fstream>
 #include <regex>
-#include <set>
-#include <sstream>
+#include <unordered_map>
 
 #include "framework/diagnostics.h"
 #include "framework/nearest_names.h"
+#include "tilth/json_input.h"
 
 namespace tilth {
 namespace {
@@ -32,27 +31,6 @@ const std::vector<std::string> kNodeKeys = {"type", "params", "description"};
 const std::vector<std::string> kIncludeKeys = {"file", "as", "variables"};
 const std::vector<std::string> kRuntimeKeys = {"max_in_flight", "when_full", "on_error"};
 
-std::pair<int, int> line_and_column(const std::string& text, std::size_t byte) {
-  int line = 1;
-  int column = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return {line, column};
-}
-
-// nlohmann's messages start with "[json.exception.parse_error.101] parse error at line
-// 3, column 5: "; keep what follows.
-std::string parse_error_reason(const std::string& what) {
-  const auto colon = what.find(": ");
-  return colon == std::string::npos ? what : what.substr(colon + 2);
-}
-
 std::string scalar_text(const json& value) {
   return value.is_string() ? value.get<std::string>() : value.dump();
 }
@@ -61,7 +39,8 @@ class Loader {
  public:
   Loader(const GraphOverrides& overrides, Diagnostics& diagnostics) : diagnostics_(diagnostics) {
     for (const auto& variable : overrides.variables) {
-      command_line_variables_[variable.key] = parse_value(variable.value);
+      command_line_variables_[variable.key] =
+          parse_value(variable.value, {"command line", "--var " + variable.key});
     }
   }
 
@@ -74,22 +53,20 @@ class Loader {
       diagnostics_.add(included_from, "include cycle: " + cycle + name);
       return;
     }
-    std::ifstream in(file);
-    if (!in) {
+    std::string text;
+    try {
+      text = read_json_text(file, "graph file '" + name + "'");
+    } catch (const JsonError& error) {
       diagnostics_.add(included_from.file.empty() ? Location{name, ""} : included_from,
-                       "cannot read graph file '" + name + "'");
+                       error.reason());
       return;
     }
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    const std::string text = buffer.str();
     json document;
     try {
-      document = json::parse(text, nullptr, true, /*ignore_comments=*/true);
-    } catch (const json::parse_error& error) {
-      const auto [line, column] = line_and_column(text, error.byte == 0 ? 0 : error.byte - 1);
-      diagnostics_.add({name, "", line, column},
-                       "malformed JSON: " + parse_error_reason(error.what()));
+      document = parse_ordered_json(text, name, {.comments = true});
+    } catch (const JsonError& error) {
+      diagnostics_.add({name, error.pointer(), error.line(), error.column()},
+                       (error.malformed() ? "malformed JSON: " : "") + error.reason());
       return;
     }
     const Location root{name, ""};
@@ -125,7 +102,7 @@ class Loader {
       const std::string node_name = setting.key.substr(0, dot);
       const std::string param = setting.key.substr(dot + 1);
       if (node_name == "runtime") {
-        json runtime = {{param, parse_value(setting.value)}};
+        json runtime = {{param, parse_value(setting.value, where)}};
         apply_runtime(runtime, where);
         continue;
       }
@@ -135,8 +112,8 @@ class Loader {
             where, "no node named '" + node_name + "'" + did_you_mean(node_name, node_names()));
         continue;
       }
-      node->params[param] = {nlohmann::json(parse_value(setting.value)), where, fs::current_path(),
-                             setting.value};
+      node->params[param] = {nlohmann::json(parse_value(setting.value, where)), where,
+                             fs::current_path(), setting.value};
     }
   }
 
@@ -146,11 +123,16 @@ class Loader {
   }
 
  private:
-  static json parse_value(const std::string& text) {
+  // JSON, or the text itself when it is not JSON; JSON that is refused (a duplicate key,
+  // a number beyond double range) is reported.
+  json parse_value(const std::string& text, const Location& where) {
     try {
-      return json::parse(text);
-    } catch (const json::parse_error&) {
-      return text;
+      return parse_ordered_json(text, where.text());
+    } catch (const JsonError& error) {
+      if (error.malformed()) return text;
+      diagnostics_.add(
+          where, (error.pointer().empty() ? "" : "at " + error.pointer() + ": ") + error.reason());
+      return nullptr;
     }
   }
 
@@ -314,6 +296,7 @@ class Loader {
           continue;
         }
         if (node == nullptr) {
+          node_index_[name] = graph_.nodes.size();
           graph_.nodes.push_back({});
           node = &graph_.nodes.back();
         }
@@ -340,14 +323,18 @@ class Loader {
 
   // An included node and every edge to or from it leave the graph.
   void remove_node(const std::string& name, const Location& where) {
-    const auto node = std::find_if(graph_.nodes.begin(), graph_.nodes.end(),
-                                   [&](const NodeSpec& n) { return n.name == name; });
-    if (node == graph_.nodes.end()) {
+    const auto found = node_index_.find(name);
+    if (found == node_index_.end()) {
       diagnostics_.add(where, "null removes an included node, but there is no node '" + name + "'" +
                                   did_you_mean(name, node_names()));
       return;
     }
-    graph_.nodes.erase(node);
+    const std::size_t removed = found->second;
+    graph_.nodes.erase(graph_.nodes.begin() + static_cast<std::ptrdiff_t>(removed));
+    node_index_.erase(found);
+    for (auto& [other, index] : node_index_) {
+      if (index > removed) --index;
+    }
     const auto touches = [&](const std::string& endpoint) {
       return endpoint.substr(0, endpoint.rfind('.')) == name;
     };
@@ -430,10 +417,8 @@ class Loader {
   }
 
   NodeSpec* find_node(const std::string& name) {
-    for (auto& node : graph_.nodes) {
-      if (node.name == name) return &node;
-    }
-    return nullptr;
+    const auto found = node_index_.find(name);
+    return found == node_index_.end() ? nullptr : &graph_.nodes[found->second];
   }
 
   std::vector<std::string> node_names() const {
@@ -444,6 +429,7 @@ class Loader {
 
   Diagnostics& diagnostics_;
   GraphSpec graph_;
+  std::unordered_map<std::string, std::size_t> node_index_;  // name -> index in graph_.nodes
   std::vector<std::string> chain_;
   std::map<std::string, json> command_line_variables_;
 };

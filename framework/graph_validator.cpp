@@ -4,6 +4,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <unordered_map>
 
 #include "framework/diagnostics.h"
 #include "framework/nearest_names.h"
@@ -65,6 +66,7 @@ class Validator {
       } else if (entry->descriptor.kind() == StageKind::kSource) {
         has_source_ = true;
       }
+      node_index_[spec.name] = nodes_.size();
       nodes_.push_back({spec.name, entry, Params{}, spec.where, {}, {}});
       inputs_.emplace_back(entry ? entry->descriptor.inputs.size() : 0);
       if (entry) nodes_.back().params = resolve_params(spec, entry->descriptor);
@@ -122,17 +124,15 @@ class Validator {
     }
     const std::string node_name = text.substr(0, dot);
     const std::string port_name = text.substr(dot + 1);
-    std::vector<std::string> names;
-    std::optional<std::size_t> node;
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
-      names.push_back(nodes_[i].name);
-      if (nodes_[i].name == node_name) node = i;
-    }
-    if (!node) {
+    const auto found = node_index_.find(node_name);
+    if (found == node_index_.end()) {
+      std::vector<std::string> names;
+      for (const auto& node : nodes_) names.push_back(node.name);
       diagnostics_.add(where, "no node named '" + node_name + "'" + did_you_mean(node_name, names));
       return std::nullopt;
     }
-    const auto* entry = nodes_[*node].stage;
+    const std::size_t node = found->second;
+    const auto* entry = nodes_[node].stage;
     if (entry == nullptr) return std::nullopt;  // already reported as an unknown type
     const auto& ports = output ? entry->descriptor.outputs : entry->descriptor.inputs;
     const auto port = port_index(ports, port_name);
@@ -144,7 +144,7 @@ class Validator {
                                   direction + "s: " + quoted_list(port_names(ports)));
       return std::nullopt;
     }
-    return Endpoint{*node, *port};
+    return Endpoint{node, *port};
   }
 
   void resolve_edges() {
@@ -269,7 +269,9 @@ class Validator {
     std::size_t node = 0;
     while (remaining[node] == 0) ++node;
     std::vector<std::size_t> path;
-    while (std::find(path.begin(), path.end(), node) == path.end()) {
+    std::vector<bool> on_path(nodes_.size());
+    while (!on_path[node]) {
+      on_path[node] = true;
       path.push_back(node);
       for (std::size_t p : predecessors(node)) {
         if (remaining[p] > 0) {
@@ -319,6 +321,8 @@ class Validator {
   const StageRegistry& registry_;
   Diagnostics diagnostics_;
   std::vector<ResolvedNode> nodes_;
+  // name -> index in nodes_; the loader gives every node its own name.
+  std::unordered_map<std::string, std::size_t> node_index_;
   std::vector<std::vector<std::optional<Feed>>> inputs_;  // per node, per input port
   bool has_source_ = false;
 };

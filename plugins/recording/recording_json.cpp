@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::recording {
 namespace {
@@ -61,14 +62,8 @@ std::string recording_color_formats() {
 
 RecordingJson read_recording_json(const fs::path& folder) {
   const fs::path file = folder / "recording.json";
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read (is this a recording folder?)");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& error) {
-    throw Error(file.string() + ": malformed JSON: " + error.what());
-  }
+  const json document =
+      parse_json(read_json_text(file, "(is this a recording folder?)"), file.string());
   if (!document.is_object()) fail(file, "", "an object", document);
   for (const auto& [key, value] : document.items()) {
     if (key != "format" && key != "calibration" && key != "color_format" && key != "description") {

@@ -1,5 +1,7 @@
 #include "classifier_model.h"
 
+#include <set>
+
 #include <opencv2/core/persistence.hpp>
 
 #include "pixel_features.h"
@@ -16,6 +18,23 @@ std::string joined(const std::vector<std::string>& names) {
 
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
   throw Error("model file '" + file.string() + "': " + what);
+}
+
+// OpenCV keeps the first of two equal keys of a map and ignores the second: refused, as
+// in every file Tilth reads, so that no value is silently other than written.
+void refuse_duplicate_keys(const std::filesystem::path& file, const cv::FileNode& node,
+                           const std::string& pointer) {
+  if (!node.isMap() && !node.isSeq()) return;
+  std::set<std::string> keys;
+  std::size_t index = 0;
+  for (const cv::FileNode& child : node) {
+    const std::string where =
+        pointer + "/" + (node.isMap() ? child.name() : std::to_string(index++));
+    if (node.isMap() && !keys.insert(child.name()).second) {
+      fail(file, where + ": expected each key once in a map, got \"" + child.name() + "\" again");
+    }
+    refuse_duplicate_keys(file, child, where);
+  }
 }
 
 }  // namespace
@@ -54,6 +73,7 @@ cv::Ptr<cv::ml::RTrees> read_classifier_model(const std::filesystem::path& file)
   } catch (const cv::Exception& exception) {
     fail(file, "not an OpenCV YAML/XML/JSON file (" + exception.msg + ")");
   }
+  refuse_duplicate_keys(file, storage.root(), "");
   const cv::FileNode format = storage["format"];
   if (!format.isString())
     fail(file, "no 'format' (expected \"" + std::string(kClassifierFormat) + "\")");

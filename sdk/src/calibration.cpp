@@ -9,11 +9,68 @@
 #include <opencv2/core.hpp>
 
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth {
 namespace {
 
 using nlohmann::json;
+
+// The physical range of a value: a calibration outside it is not of a real rig, however
+// well-formed, and would give valid-looking but wrong distances.
+struct Bounds {
+  double low;
+  double high;
+  bool low_open;    // (low, high] rather than [low, high]
+  std::string why;  // said in the error
+};
+
+std::string number_text(double x) {
+  std::ostringstream text;
+  text << x;
+  return text.str();
+}
+
+// A pinhole focal length gives a field of view of 2 atan(size / 2f) across an image
+// side of `size` pixels. Machine-vision and ToF lenses span about 5 to 120 degrees; 1 to
+// 160 degrees leaves room for any of them, and refuses a focal length typed in mm, or in
+// the pixels of another image size, or a field of view beyond what a pinhole model with
+// polynomial distortion can describe.
+Bounds focal_length_bounds(int size, const char* side) {
+  constexpr double kDegree = 3.14159265358979323846 / 180.0;
+  return {size / 2.0 / std::tan(80 * kDegree), size / 2.0 / std::tan(0.5 * kDegree), false,
+          " px: a field of view across the " + std::to_string(size) + "-px " + side +
+              " between 1 and 160 degrees"};
+}
+
+// The principal point is where the optical axis meets the sensor: inside the image,
+// whose pixels' centres are 0 .. size - 1 (edges at -0.5 and size - 0.5).
+Bounds principal_point_bounds(int size, const char* side) {
+  return {-0.5, size - 0.5, false, " px: inside the " + std::to_string(size) + "-px " + side};
+}
+
+// OpenCV's radial terms k1, k2, k3 of lenses up to 120 degrees calibrate to |k| below 1,
+// with k3 of a wide lens up to a few; 10 folds the image within a normalised radius of
+// 0.2 (a few degrees off axis), which no lens does. Tangential terms p1, p2 come from a
+// lens mounted off-centre by a fraction of a pixel: below 0.01; 0.1 would shift a corner
+// pixel by a tenth of the focal length.
+const Bounds kRadialDistortion{-10.0, 10.0, false, ": radial terms k1, k2, k3 of a real lens"};
+const Bounds kTangentialDistortion{-0.1, 0.1, false, ": tangential terms p1, p2 of a real lens"};
+
+// A 16-bit ToF value spans 65535 * gray_to_mm: 1.5 m for the Basler blaze (0.0229 mm),
+// 65 m for a camera that counts whole millimetres. No ToF camera ranges beyond that
+// twice over.
+const Bounds kGrayToMm{0.0, 2.0, true, " mm per gray value: a 16-bit range of at most 131 m"};
+// The zero of the ToF distance (gray_offset_mm) and the optical centre (z_offset_mm) lie
+// within the camera's housing, which is under 200 mm in every direction for any ToF
+// camera made for machines (Basler blaze 100 x 81 x 64 mm).
+const Bounds kGrayOffsetMm{-200.0, 200.0, false, " mm: within a ToF camera's housing"};
+const Bounds kZOffsetMm{-200.0, 200.0, false,
+                        " mm: the optical centre within the camera's housing, behind its "
+                        "mounting surface"};
+// The two cameras of a rig see the same patch of soil 0.3 to 1.5 m away: a metre apart,
+// their views at working distance hardly overlap.
+constexpr double kMaxBaselineMm = 1000.0;
 
 // Reads one object of the file, remembering where it is, so every error names its field.
 class Reader {
@@ -57,8 +114,22 @@ class Reader {
     return x;
   }
 
-  double number_or(const std::string& key, double fallback) const {
-    return find(key) ? number(key) : fallback;
+  double number(const std::string& key, const Bounds& bounds) const {
+    return check(key, required(key), number(key), bounds);
+  }
+
+  double number_or(const std::string& key, double fallback, const Bounds& bounds) const {
+    return find(key) ? number(key, bounds) : fallback;
+  }
+
+  // `key` may be a pointer below this object ("distortion/0"); `value` is as written.
+  double check(const std::string& key, const json& value, double x, const Bounds& bounds) const {
+    const bool above_low = bounds.low_open ? x > bounds.low : x >= bounds.low;
+    if (above_low && x <= bounds.high) return x;
+    fail("/" + key,
+         "a number in " + std::string(bounds.low_open ? "(" : "[") + number_text(bounds.low) +
+             ", " + number_text(bounds.high) + "]" + bounds.why,
+         value);
   }
 
   int positive_integer(const std::string& key) const {
@@ -86,6 +157,9 @@ class Reader {
     for (std::size_t i = 0; i < count; ++i) {
       if (!value[i].is_number()) {
         fail("/" + key + "/" + std::to_string(i), "a number", value[i]);
+      }
+      if (!std::isfinite(value[i].get<double>())) {
+        fail("/" + key + "/" + std::to_string(i), "a finite number", value[i]);
       }
       result.push_back(value[i].get<double>());
     }
@@ -117,12 +191,19 @@ void read_intrinsics(const Reader& camera, CameraIntrinsics& intrinsics) {
   intrinsics.model = camera.string_or("model", "");
   intrinsics.width = camera.positive_integer("width");
   intrinsics.height = camera.positive_integer("height");
-  intrinsics.fx = camera.number("fx", 0.0);
-  intrinsics.fy = camera.number("fy", 0.0);
-  intrinsics.cx = camera.number("cx");
-  intrinsics.cy = camera.number("cy");
+  intrinsics.fx = camera.check("fx", camera.required("fx"), camera.number("fx", 0.0),
+                               focal_length_bounds(intrinsics.width, "width"));
+  intrinsics.fy = camera.check("fy", camera.required("fy"), camera.number("fy", 0.0),
+                               focal_length_bounds(intrinsics.height, "height"));
+  intrinsics.cx = camera.number("cx", principal_point_bounds(intrinsics.width, "width"));
+  intrinsics.cy = camera.number("cy", principal_point_bounds(intrinsics.height, "height"));
   if (camera.find("distortion")) {
     const auto k = camera.numbers("distortion", 5);
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      const bool tangential = i == 2 || i == 3;
+      camera.check("distortion/" + std::to_string(i), camera.required("distortion")[i], k[i],
+                   tangential ? kTangentialDistortion : kRadialDistortion);
+    }
     std::copy(k.begin(), k.end(), intrinsics.distortion.begin());
   }
 }
@@ -170,9 +251,9 @@ RigCalibration parse_calibration(const json& document, const std::string& origin
   } else {
     depth.fail("/depth_measure", "\"radial\" or \"z\"", measure);
   }
-  rig.depth.gray_to_mm = depth.number("gray_to_mm", 0.0);
-  rig.depth.gray_offset_mm = depth.number_or("gray_offset_mm", 0.0);
-  rig.depth.z_offset_mm = depth.number("z_offset_mm");
+  rig.depth.gray_to_mm = depth.number("gray_to_mm", kGrayToMm);
+  rig.depth.gray_offset_mm = depth.number_or("gray_offset_mm", 0.0, kGrayOffsetMm);
+  rig.depth.z_offset_mm = depth.number("z_offset_mm", kZOffsetMm);
 
   const Reader color = root.child("color_camera");
   color.only_keys({"model", "width", "height", "fx", "fy", "cx", "cy", "distortion"});
@@ -205,19 +286,18 @@ RigCalibration parse_calibration(const json& document, const std::string& origin
   }
   const auto t = extrinsics.numbers("T_mm", 3);
   rig.depth_to_color_t_mm = {t[0], t[1], t[2]};
+  if (const double baseline = cv::norm(rig.depth_to_color_t_mm); baseline > kMaxBaselineMm) {
+    throw Error(origin + ":" + extrinsics.pointer() + "/T_mm: expected a translation of at most " +
+                number_text(kMaxBaselineMm) +
+                " mm (the two cameras of one rig, seeing the same soil), got " +
+                number_text(baseline) + " mm");
+  }
   return rig;
 }
 
 RigCalibration load_calibration(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read calibration file");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& error) {
-    throw Error(file.string() + ": malformed JSON: " + error.what());
-  }
-  return parse_calibration(document, file.string());
+  const std::string origin = file.string();
+  return parse_calibration(parse_json(read_json_text(file, "calibration file"), origin), origin);
 }
 
 json to_json(const RigCalibration& rig) {

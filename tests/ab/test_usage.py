@@ -107,7 +107,23 @@ class UsageTest(unittest.TestCase):
                             variants + ":/variants/3/name: variant 'a' is defined twice")
         with open(variants, "w") as f:
             f.write('{"variants": [}')
-        self.assert_refused(ab(CASE_C, "--variants", variants), variants + ": malformed JSON")
+        self.assert_refused(ab(CASE_C, "--variants", variants), variants + ":1:15: malformed JSON")
+        # The second "set" silently replaced the first.
+        with open(variants, "w") as f:
+            f.write('{"variants": [{"name": "a", "set": {"segment.dilation_px": 4}, "set": {}}]}')
+        self.assert_refused(ab(CASE_C, "--variants", variants),
+                            variants + ":/variants/0/set: expected each key once in an object, "
+                            "got \"set\" again")
+
+    def test_numbers_are_read_whole(self):
+        for option, text, expected in [
+                ("--jobs", "2x", "--jobs: expected a whole number in [1, 256], got '2x'"),
+                ("--jobs", "0", "--jobs: expected a whole number in [1, 256], got '0'"),
+                ("--overlays", "-1", "--overlays: expected a whole number in [0, 100], got '-1'"),
+                ("--no-soil-below", "0.1x",
+                 "--no-soil-below: expected a number in [0, 1], got '0.1x'")]:
+            self.assert_refused(ab(CASE_C, "--variant", "a", option, text, "--out", self.out),
+                                "tilth ab: " + expected)
 
     def test_output_folder_is_protected(self):
         os.makedirs(self.out)

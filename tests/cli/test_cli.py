@@ -86,6 +86,42 @@ class Validation(unittest.TestCase):
         self.assertIn("nothing was run", result.stderr)
 
 
+class UntrustedInput(unittest.TestCase):
+    def test_numbers_are_read_whole(self):
+        # "5abc" ran 5 frames and "-1" ran forever, both with exit code 0.
+        for text in ["5abc", "-1", "0", " 5", "5.0", "1e3", ""]:
+            result = tilth("run", PLANE, "--frames", text, "--set", "camera.fps=0", timeout=20)
+            self.assertEqual(result.returncode, 2, text)
+            self.assertIn("--frames: expected a whole number in [1, 1000000000000], got '%s'"
+                          % text, result.stderr)
+            self.assertEqual(result.stdout, "", text)
+
+    def test_numbers_beyond_double_range_are_located(self):
+        # These aborted with an uncaught exception (SIGABRT).
+        result = tilth("validate", PLANE, "--set", "camera.distance_mm=1e999")
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertIn("command line:--set camera.distance_mm: expected a number within double "
+                      "range (magnitude below 1.8e308), got 1e999", result.stderr)
+        result = tilth("validate", PLANE, "--var", "x=1e999")
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertIn("command line:--var x: expected a number within double range", result.stderr)
+
+    def test_include_of_a_device_or_fifo_is_refused(self):
+        # "/dev/zero" was read until memory ran out; a FIFO waits for a writer forever.
+        with tempfile.TemporaryDirectory() as tmp:
+            fifo = os.path.join(tmp, "fifo.json")
+            os.mkfifo(fifo)
+            path = os.path.join(tmp, "g.json")
+            with open(path, "w") as f:
+                f.write('{"include": ["/dev/zero", "fifo.json"]}')
+            result = tilth("validate", path, timeout=20)
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertIn(path + ":/include/0/file: cannot read graph file '/dev/zero': expected a "
+                      "regular file, got a character device", result.stderr)
+        self.assertIn(path + ":/include/1/file: cannot read graph file '" + fifo + "': expected a "
+                      "regular file, got a FIFO", result.stderr)
+
+
 class Run(unittest.TestCase):
     def test_frame_limit_and_summary(self):
         result = tilth("run", PLANE, "--frames", "10", "--set", "camera.fps=0",

@@ -204,5 +204,65 @@ TEST(GraphLoader, ParseSettingNeedsEquals) {
   EXPECT_THROW(parse_setting("--set", "a.b"), Error);
 }
 
+// These aborted the process: nlohmann throws out_of_range, not parse_error, for a number
+// that overflows a double.
+TEST(GraphLoader, NumberBeyondDoubleRangeIsLocated) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({"nodes": {"src": {"type": "test.counter",
+    "params": {"count": 1e400}}}})");
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":/nodes/src/params/count: expected a number within double "
+                                  "range (magnitude below 1.8e308), got 1e400");
+
+  const auto plain = dir.write("plain.json", R"({"nodes": {"src": {"type": "test.counter"}}})");
+  GraphOverrides set;
+  set.params = {{"src.count", "1e999"}};
+  EXPECT_EQ(load_error(plain, set),
+            "command line:--set src.count: expected a number within double range (magnitude "
+            "below 1.8e308), got 1e999");
+  GraphOverrides var;
+  var.variables = {{"x", "-1e999"}};
+  EXPECT_EQ(load_error(plain, var),
+            "command line:--var x: expected a number within double range (magnitude below "
+            "1.8e308), got -1e999");
+  GraphOverrides twice;
+  twice.params = {{"src.count", R"({"a": 1, "a": 2})"}};
+  EXPECT_EQ(load_error(plain, twice),
+            "command line:--set src.count: at /a: expected each key once in an object, got "
+            "\"a\" again");
+}
+
+// 50 000 nested arrays overflowed the stack (SIGSEGV) in the recursive walks of the
+// document; the reader stops at the 65th level.
+TEST(GraphLoader, DeepNestingIsRefused) {
+  TempDir dir;
+  const auto file =
+      dir.write("g.json", R"({"nodes": {"src": {"type": "test.counter", "params": {"count": )" +
+                              std::string(50'000, '[') + std::string(50'000, ']') + "}}}}");
+  std::string pointer = "/nodes/src/params/count";
+  for (int level = 4; level < 64; ++level) pointer += "/0";
+  EXPECT_EQ(load_error(file), file.string() + ":" + pointer +
+                                  ": expected at most 64 nested arrays and objects, got more");
+}
+
+TEST(GraphLoader, DuplicateKeysAreRefused) {
+  TempDir dir;
+  // The second "src" silently replaced the first.
+  const auto file = dir.write("g.json", R"({"nodes": {"src": {"type": "test.counter"},
+    "src": {"type": "test.other"}}})");
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":/nodes/src: expected each key once in an object, got \"src\" "
+                                  "again");
+}
+
+// An include of /dev/zero read forever; a FIFO would wait for a writer.
+TEST(GraphLoader, IncludeOfADeviceIsRefused) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({"include": ["/dev/zero"]})");
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":/include/0/file: cannot read graph file '/dev/zero': expected "
+                                  "a regular file, got a character device");
+}
+
 }  // namespace
 }  // namespace tilth

@@ -79,8 +79,9 @@ def read_png(path):
 def small_calibration():
     with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
         calibration = json.load(f)
-    calibration["depth_camera"].update(width=20, height=16)
-    calibration["color_camera"].update(width=28, height=18)
+    # The principal points move with the sizes: a calibration's must lie inside its image.
+    calibration["depth_camera"].update(width=20, height=16, cx=9.5, cy=7.5)
+    calibration["color_camera"].update(width=28, height=18, cx=13.5, cy=8.5)
     return calibration
 
 

@@ -189,6 +189,17 @@ TEST_F(ImageFolderSourceTest, RecordingJsonErrorsNameTheFieldAndWhatWasExpected)
   EXPECT_EQ(start_failure(), json_file() + ":/colour_format: no such field (misspelt?)");
 }
 
+// The last "color_format" was kept: the frames were read as Bayer mosaics.
+TEST_F(ImageFolderSourceTest, RecordingJsonWithADuplicateKeyIsRefused) {
+  record(1);
+  std::string text = read_text(folder_ / "recording.json");
+  text.replace(text.rfind('}'), 1, ", \"color_format\": \"bayer_rggb8\"}");
+  write_text(folder_ / "recording.json", text);
+  EXPECT_EQ(start_failure(), json_file() +
+                                 ":/color_format: expected each key once in an object, got "
+                                 "\"color_format\" again");
+}
+
 TEST_F(ImageFolderSourceTest, ReferencedCalibrationErrorsNameItsFile) {
   record(1);
   json calibration = small_calibration();

@@ -60,10 +60,15 @@ fs::path shipped_calibration_file() {
 
 nlohmann::json small_calibration() {
   nlohmann::json calibration = nlohmann::json::parse(read_text(shipped_calibration_file()));
+  // The principal points move with the sizes: a calibration's must lie inside its image.
   calibration["depth_camera"]["width"] = 32;
   calibration["depth_camera"]["height"] = 24;
+  calibration["depth_camera"]["cx"] = 15.5;
+  calibration["depth_camera"]["cy"] = 11.5;
   calibration["color_camera"]["width"] = 40;
   calibration["color_camera"]["height"] = 30;
+  calibration["color_camera"]["cx"] = 19.5;
+  calibration["color_camera"]["cy"] = 14.5;
   return calibration;
 }
 

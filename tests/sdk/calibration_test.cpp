@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "temp_dir.h"
 #include "tilth/error.h"
 
 namespace tilth {
@@ -129,6 +130,107 @@ TEST(Calibration, ErrorsNameTheField) {
 
 TEST(Calibration, UnreadableFile) {
   EXPECT_THROW(load_calibration("/nonexistent.calib.json"), Error);
+}
+
+std::string load_error(const std::filesystem::path& file) {
+  try {
+    load_calibration(file);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "loaded";
+}
+
+// Each of these was accepted and gave valid-looking distances: z_offset_mm 600 put the
+// soil 58 mm above the camera, gray_to_mm 1e6 at 2.4e10 mm.
+TEST(Calibration, ValuesNoRealRigHasAreRefused) {
+  const auto refused = [](const char* camera, const char* key, const json& value) {
+    json document = paper_rig_json();
+    document[camera][key] = value;
+    return parse_error(document);
+  };
+  EXPECT_EQ(refused("depth_camera", "z_offset_mm", 600),
+            "rig.json:/depth_camera/z_offset_mm: expected a number in [-200, 200] mm: the optical "
+            "centre within the camera's housing, behind its mounting surface, got 600");
+  EXPECT_EQ(refused("depth_camera", "gray_to_mm", 1e6),
+            "rig.json:/depth_camera/gray_to_mm: expected a number in (0, 2] mm per gray value: a "
+            "16-bit range of at most 131 m, got 1000000.0");
+  EXPECT_EQ(refused("depth_camera", "gray_offset_mm", 1e6),
+            "rig.json:/depth_camera/gray_offset_mm: expected a number in [-200, 200] mm: within a "
+            "ToF camera's housing, got 1000000.0");
+  // 1250 px is a 54 degree view across the colour camera's 1280 px; 5 px would be 179.
+  EXPECT_EQ(refused("color_camera", "fx", 5),
+            "rig.json:/color_camera/fx: expected a number in [112.849, 73336.7] px: a field of "
+            "view across the 1280-px width between 1 and 160 degrees, got 5");
+  EXPECT_EQ(refused("depth_camera", "fy", 4.8),  // the lens's focal length in mm
+            "rig.json:/depth_camera/fy: expected a number in [42.3185, 27501.3] px: a field of "
+            "view across the 480-px height between 1 and 160 degrees, got 4.8");
+  EXPECT_EQ(refused("color_camera", "cx", 1280),
+            "rig.json:/color_camera/cx: expected a number in [-0.5, 1279.5] px: inside the 1280-px "
+            "width, got 1280");
+  EXPECT_EQ(refused("depth_camera", "cy", -1),
+            "rig.json:/depth_camera/cy: expected a number in [-0.5, 479.5] px: inside the 480-px "
+            "height, got -1");
+  EXPECT_EQ(refused("depth_camera", "distortion", json{0, 0, 0.5, 0, 0}),
+            "rig.json:/depth_camera/distortion/2: expected a number in [-0.1, 0.1]: tangential "
+            "terms p1, p2 of a real lens, got 0.5");
+  EXPECT_EQ(refused("color_camera", "distortion", json{0, 0, 0, 0, -40}),
+            "rig.json:/color_camera/distortion/4: expected a number in [-10, 10]: radial terms "
+            "k1, k2, k3 of a real lens, got -40");
+  json far = paper_rig_json();
+  far["depth_to_color"]["T_mm"] = {1200, 0, 500};
+  EXPECT_EQ(parse_error(far),
+            "rig.json:/depth_to_color/T_mm: expected a translation of at most 1000 mm (the two "
+            "cameras of one rig, seeing the same soil), got 1300 mm");
+}
+
+TEST(Calibration, BoundsAdmitRealRigs) {
+  json document = paper_rig_json();
+  document["depth_camera"]["gray_to_mm"] = 1.0;  // a camera counting whole millimetres
+  document["depth_camera"]["gray_offset_mm"] = -150;
+  document["depth_camera"]["z_offset_mm"] = 0;
+  document["depth_camera"]["cx"] = -0.5;  // the image's edges
+  document["depth_camera"]["cy"] = 479.5;
+  document["color_camera"]["fx"] = 300;  // a 130 degree wide-angle lens
+  document["color_camera"]["distortion"] = {-0.3, 0.12, 0.001, -0.001, -0.02};
+  document["depth_to_color"]["T_mm"] = {0, -600, 0};
+  const RigCalibration rig = parse_calibration(document, "rig.json");
+  EXPECT_EQ(rig.depth.gray_to_mm, 1.0);
+  EXPECT_EQ(rig.depth.cx, -0.5);
+  EXPECT_EQ(rig.color.distortion[4], -0.02);
+}
+
+TEST(Calibration, FileWithADuplicateKeyIsRefused) {
+  testing::TempDir dir;
+  std::ifstream in(kPaperRig);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The last "fx" was kept: 497 px where the rig has 518 gives distances 4 % off.
+  text.replace(text.find("\"fx\": 509.935,"), 14, "\"fx\": 497, \"fx\": 509.935,");
+  const auto file = dir.write("rig.calib.json", text);
+  EXPECT_EQ(load_error(file), file.string() +
+                                  ":/depth_camera/fx: expected each key once in an object, got "
+                                  "\"fx\" again");
+}
+
+TEST(Calibration, FileBeyondWhatJsonReadersTakeIsRefused) {
+  testing::TempDir dir;
+  const auto deep = dir.write("deep.calib.json", "{\"format\": " + std::string(50'000, '[') +
+                                                     std::string(50'000, ']') + "}");
+  EXPECT_NE(load_error(deep).find(":/format/0/0/"), std::string::npos);
+  EXPECT_NE(load_error(deep).find(": expected at most 64 nested arrays and objects, got more"),
+            std::string::npos);
+
+  std::ifstream in(kPaperRig);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("0.0229"), 6, "1e400");
+  const auto overflow = dir.write("overflow.calib.json", text);
+  EXPECT_EQ(load_error(overflow), overflow.string() +
+                                      ":/depth_camera/gray_to_mm: expected a number within double "
+                                      "range (magnitude below 1.8e308), got 1e400");
+
+  EXPECT_EQ(load_error("/dev/zero"),
+            "/dev/zero: cannot read calibration file: expected a regular file, got a character "
+            "device");
 }
 
 }  // namespace

@@ -169,5 +169,15 @@ TEST(PixelClassifierModel, NoForest) {
                 "': no 'forest' (expected the random forest written by tilth train-segmenter)");
 }
 
+// OpenCV would keep the first "training" and ignore the second.
+TEST(PixelClassifierModel, DuplicateKey) {
+  testing::TempDir temp;
+  const auto file =
+      temp.write("straw.yml", edited_model("training:", "training: \"a\"\ntraining:"));
+  EXPECT_EQ(construction_error(file),
+            "model file '" + file.string() +
+                "': /training: expected each key once in a map, got \"training\" again");
+}
+
 }  // namespace
 }  // namespace tilth::segmentation

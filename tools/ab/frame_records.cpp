@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::ab {
 namespace {
@@ -37,7 +38,7 @@ std::vector<FrameRecord> read_frame_records(const std::filesystem::path& file) {
     ++number;
     if (text.empty()) continue;
     try {
-      const json line = json::parse(text);
+      const json line = parse_json(text, file.string() + ":" + std::to_string(number));
       FrameRecord record;
       record.frame_id = line.at("frame_id").get<std::uint64_t>();
       record.device_timestamp_ns = line.at("device_timestamp_ns").get<std::int64_t>();

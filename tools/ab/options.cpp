@@ -45,18 +45,10 @@ summary.json, summary.csv and frames.csv. docs/ab-testing.md explains every figu
 
 namespace {
 
-std::size_t count_option(const cli::CommandLine& line, const std::string& option,
-                         std::size_t fallback) {
-  const auto text = line.value(option);
-  if (!text) return fallback;
-  try {
-    std::size_t used = 0;
-    const long long value = std::stoll(*text, &used);
-    if (used == text->size() && value >= 0) return static_cast<std::size_t>(value);
-  } catch (const std::exception&) {
-  }
-  throw UsageError(option + ": expected a whole number >= 0, got '" + *text + "'");
-}
+// Each job holds a graph's frames in memory; more than this is no machine's core count.
+constexpr std::uint64_t kMaxJobs = 256;
+// Each overlay is an image embedded in the report page.
+constexpr std::uint64_t kMaxOverlays = 100;
 
 fs::path default_chain(const cli::CommandLine& line) {
   if (const auto chain = line.value("--chain")) {
@@ -92,18 +84,13 @@ Options parse_options(int argc, char** argv) {
   }
   options.layout.dir = fs::absolute(line.value("--out").value_or("ab-report")).lexically_normal();
   options.overwrite = line.flag("--overwrite");
-  options.jobs = count_option(line, "--jobs", std::max(1u, std::thread::hardware_concurrency()));
-  if (options.jobs == 0) throw UsageError("--jobs: expected at least 1");
-  options.overlays = count_option(line, "--overlays", 3);
-  if (const auto text = line.value("--no-soil-below")) {
-    try {
-      options.no_soil_below = std::stod(*text);
-    } catch (const std::exception&) {
-      options.no_soil_below = -1.0;
-    }
-    if (!(options.no_soil_below >= 0.0 && options.no_soil_below <= 1.0)) {
-      throw UsageError("--no-soil-below: expected a fraction in [0, 1], got '" + *text + "'");
-    }
+  try {
+    options.jobs = line.count("--jobs", 1, kMaxJobs)
+                       .value_or(std::max(1u, std::thread::hardware_concurrency()));
+    options.overlays = line.count("--overlays", 0, kMaxOverlays).value_or(options.overlays);
+    options.no_soil_below = line.real("--no-soil-below", 0.0, 1.0).value_or(options.no_soil_below);
+  } catch (const Error& error) {
+    throw UsageError(error.what());
   }
   options.keep_images = line.flag("--keep-images");
   options.quiet = line.flag("--quiet");

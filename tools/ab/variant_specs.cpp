@@ -10,12 +10,11 @@
 #include "variant_specs.h"
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 #include "framework/diagnostics.h"
 #include "framework/nearest_names.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::ab {
 namespace {
@@ -41,11 +40,14 @@ std::pair<std::string, std::string> split_node_key(const std::string& key) {
   return {key.substr(0, dot), key.substr(dot + 1)};
 }
 
-nlohmann::json parse_json_or_text(const std::string& text) {
+// JSON, or the text itself when it is not JSON (as --set); JSON that is refused (a
+// duplicate key, a number beyond double range) is an error.
+nlohmann::json parse_json_or_text(const std::string& text, const std::string& where) {
   try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error&) {
-    return text;
+    return parse_json(text, where);
+  } catch (const JsonError& error) {
+    if (error.malformed()) return text;
+    throw;
   }
 }
 
@@ -60,18 +62,13 @@ class FileReader {
 
   void read(std::vector<Variant>& variants) {
     const Location root{file_, ""};
-    std::ifstream in(file_);
-    if (!in) {
-      problems_.add(root, "cannot read the variants file");
-      problems_.throw_if_any();
-    }
-    std::stringstream text;
-    text << in.rdbuf();
     json document;
     try {
-      document = json::parse(text.str(), nullptr, true, /*ignore_comments=*/true);
-    } catch (const json::parse_error& error) {
-      problems_.add(root, std::string("malformed JSON: ") + error.what());
+      document =
+          parse_ordered_json(read_json_text(file_, "the variants file"), file_, {.comments = true});
+    } catch (const JsonError& error) {
+      problems_.add({file_, error.pointer(), error.line(), error.column()},
+                    (error.malformed() ? "malformed JSON: " : "") + error.reason());
       problems_.throw_if_any();
     }
     if (!document.is_object() || !document.contains("variants") ||
@@ -237,8 +234,8 @@ void add_variant_option(const std::string& option, const fs::path& default_chain
     throw Error(where + ": expected NODE.PARAM=VALUE or NODE.type=STAGE_TYPE, got key '" + key +
                 "'");
   }
-  variant->settings.push_back({node, param, parse_json_or_text(value), value, fs::current_path(),
-                               Location{"command line", where}});
+  variant->settings.push_back({node, param, parse_json_or_text(value, where), value,
+                               fs::current_path(), Location{"command line", where}});
 }
 
 }  // namespace tilth::ab

@@ -5,6 +5,7 @@
 #include "framework/graph_session.h"
 #include "framework/graph_validator.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::tools {
 
@@ -35,8 +36,13 @@ void InProcessGraph::add_node(const std::string& name, const std::string& type,
 
 void InProcessGraph::set_from_option(const std::string& node_name, const std::string& param,
                                      const std::string& option, const std::string& text) {
-  nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
-  if (value.is_discarded()) value = text;
+  // JSON, or the text itself when it is not JSON (as --set).
+  nlohmann::json value = text;
+  try {
+    value = parse_json(text, Location{program_, option}.text());
+  } catch (const JsonError& error) {
+    if (!error.malformed()) throw;
+  }
   node(node_name).params[param] =
       ParamValue{value, Location{program_, option}, std::filesystem::current_path(), text};
 }

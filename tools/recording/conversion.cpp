@@ -11,6 +11,7 @@
 #include "output_path.h"
 #include "recording_layout.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::tools {
 namespace {
@@ -63,10 +64,9 @@ void connect_recording_ports(InProcessGraph& graph) {
 // `scratch`; the rest of recording.json is the source stage's to check.
 fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scratch) {
   const fs::path file = folder / "recording.json";
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read (is this an image-folder recording?)");
-  const json recording = json::parse(in, nullptr, false);
-  if (recording.is_discarded() || !recording.is_object()) {
+  const json recording =
+      parse_json(read_json_text(file, "(is this an image-folder recording?)"), file.string());
+  if (!recording.is_object()) {
     throw Error(file.string() + ": expected a JSON object (spec: tilth-image-folder/1)");
   }
   const auto calibration = recording.find("calibration");

@@ -7,14 +7,13 @@
 #include <set>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "command_line.h"
 #include "commands.h"
 #include "framework/diagnostics.h"
 #include "in_process_graph.h"
 #include "output_path.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace {
 
@@ -52,8 +51,12 @@ int usage_error(const std::string& message) {
 // Whether --fps asks for pacing; a malformed value is the stage's to report.
 bool paced(const std::optional<std::string>& fps) {
   if (!fps) return false;
-  const auto value = nlohmann::json::parse(*fps, nullptr, false);
-  return value.is_number() && value.get<double>() > 0;
+  try {
+    const auto value = tilth::parse_json(*fps, "--fps");
+    return value.is_number() && value.get<double>() > 0;
+  } catch (const tilth::JsonError&) {
+    return false;
+  }
 }
 
 // The command as typed, for the recording's description.

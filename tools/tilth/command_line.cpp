@@ -1,8 +1,32 @@
 #include "command_line.h"
 
+#include <charconv>
+#include <sstream>
+
 #include "tilth/error.h"
 
 namespace tilth::cli {
+namespace {
+
+template <typename Number>
+std::optional<Number> whole_text_number(const std::string& text) {
+  Number value{};
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (error != std::errc() || stop != end || text.empty()) return std::nullopt;
+  return value;
+}
+
+template <typename Number>
+[[noreturn]] void refuse(const std::string& option, const std::string& what, Number min, Number max,
+                         const std::string& text) {
+  std::ostringstream message;
+  message << option << ": expected " << what << " in [" << min << ", " << max << "], got '" << text
+          << "'";
+  throw Error(message.str());
+}
+
+}  // namespace
 
 CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
                          const std::set<std::string>& flags) {
@@ -40,6 +64,23 @@ std::optional<std::string> CommandLine::value(const std::string& option) const {
   auto all = values(option);
   if (all.empty()) return std::nullopt;
   return all.back();
+}
+
+std::optional<std::uint64_t> CommandLine::count(const std::string& option, std::uint64_t min,
+                                                std::uint64_t max) const {
+  const auto text = value(option);
+  if (!text) return std::nullopt;
+  const auto number = whole_text_number<std::uint64_t>(*text);
+  if (!number || *number < min || *number > max) refuse(option, "a whole number", min, max, *text);
+  return number;
+}
+
+std::optional<double> CommandLine::real(const std::string& option, double min, double max) const {
+  const auto text = value(option);
+  if (!text) return std::nullopt;
+  const auto number = whole_text_number<double>(*text);
+  if (!number || !(*number >= min && *number <= max)) refuse(option, "a number", min, max, *text);
+  return number;
 }
 
 }  // namespace tilth::cli

@@ -2,6 +2,7 @@
 // KEY=VALUE options and flags.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <set>
@@ -21,6 +22,12 @@ class CommandLine {
   std::vector<std::string> values(const std::string& option) const;
   std::optional<std::string> value(const std::string& option) const;
   bool flag(const std::string& option) const { return flags_.count(option) > 0; }
+  // The option's value read as a whole: digits only for a count ("5abc", "-1", " 5" and
+  // "5.0" are refused), a decimal number for a real. Throws tilth::Error naming the
+  // option, the range expected and the text given.
+  std::optional<std::uint64_t> count(const std::string& option, std::uint64_t min,
+                                     std::uint64_t max) const;
+  std::optional<double> real(const std::string& option, double min, double max) const;
 
  private:
   std::vector<std::string> positional_;

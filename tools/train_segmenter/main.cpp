@@ -1,9 +1,11 @@
 // `tilth train-segmenter` (the tilth-train-segmenter program): trains the random forest of
 // segmentation.pixel_classifier from recordings with ground-truth masks, reports how well
 // it does on held-out frames, and writes the model file.
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <set>
 #include <string>
@@ -55,21 +57,6 @@ int usage_error(const std::string& message) {
   return kExitUsage;
 }
 
-long positive(const CommandLine& line, const std::string& option, long fallback) {
-  const auto text = line.value(option);
-  if (!text) return fallback;
-  std::size_t used = 0;
-  long value = -1;
-  try {
-    value = std::stol(*text, &used);
-  } catch (const std::exception&) {
-  }
-  if (used != text->size() || value < 1) {
-    throw tilth::Error(option + ": expected a positive integer, got '" + *text + "'");
-  }
-  return value;
-}
-
 // The source stage that reads a recording: a folder is an image-folder recording.
 RegisteredFrames open_recording(const tilth::StageRegistry& registry, const fs::path& recording,
                                 const fs::path& calibration) {
@@ -114,12 +101,14 @@ int main(int argc, char** argv) {
   }
   if (line.positional().empty()) return usage_error("expected at least one RECORDING");
   if (!line.value("--out")) return usage_error("--out MODEL is required");
-  long samples = 0, seed = 0, trees = 0, depth = 0;
+  std::uint64_t samples = 0, seed = 0, trees = 0, depth = 0;
   try {
-    samples = positive(line, "--samples", 2000);
-    seed = positive(line, "--seed", 1);
-    trees = positive(line, "--trees", 50);
-    depth = positive(line, "--depth", 12);
+    // A frame has 300 000 pixels; OpenCV caps a tree's depth at 25 levels; 10 000 trees
+    // take hours to train.
+    samples = line.count("--samples", 1, 1'000'000).value_or(2000);
+    seed = line.count("--seed", 1, std::numeric_limits<std::uint32_t>::max()).value_or(1);
+    trees = line.count("--trees", 1, 10'000).value_or(50);
+    depth = line.count("--depth", 1, 25).value_or(12);
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
   }
@@ -138,10 +127,9 @@ int main(int argc, char** argv) {
       std::uint64_t used = 0, kept_out = 0, unlabelled = 0, position = 0;
       while (const auto frame = frames.next()) {
         const bool hold_out = tests.empty() && position++ % kHoldOutEvery == kHoldOutEvery - 1;
-        const bool labelled =
-            hold_out ? held_out.add(*frame)
-                     : training.sample(*frame, static_cast<std::size_t>(samples),
-                                       static_cast<std::uint64_t>(seed) * 1'000'003 + draw++);
+        const bool labelled = hold_out ? held_out.add(*frame)
+                                       : training.sample(*frame, static_cast<std::size_t>(samples),
+                                                         seed * 1'000'003 + draw++);
         (labelled ? (hold_out ? kept_out : used) : unlabelled) += 1;
       }
       std::cout << recording << ": " << used << " frames for training, " << kept_out
