@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tilth/error.h"
+#include "tilth/regular_file.h"
 
 namespace tilth::recording {
 namespace {
@@ -27,6 +28,17 @@ std::string shortened(const json& value) {
   throw Error(file.string() + ":" + pointer + ": expected " + expected + ", got " + shortened(got));
 }
 
+// A recording.json or calibration file: small JSON files, so a regular file of at most
+// 16 MiB.
+json parse_json(const fs::path& file, std::string_view what) {
+  constexpr std::uint64_t kMaxBytes = 16 << 20;
+  try {
+    return json::parse(read_regular_file(file, kMaxBytes, what));
+  } catch (const json::parse_error& error) {
+    throw Error(file.string() + ": malformed JSON: " + error.what());
+  }
+}
+
 const json& required(const json& document, const fs::path& file, const std::string& key) {
   const auto it = document.find(key);
   if (it == document.end()) throw Error(file.string() + ":/" + key + ": missing required field");
@@ -39,7 +51,10 @@ RigCalibration read_calibration(const json& value, const fs::path& folder, const
     fail(file, "/calibration",
          "a calibration file name relative to the folder, or a calibration object", value);
   }
-  return load_calibration(folder / value.get<std::string>());
+  const fs::path calibration = folder / value.get<std::string>();
+  if (!fs::exists(calibration))
+    throw Error(calibration.string() + ": cannot read calibration file");
+  return parse_calibration(parse_json(calibration, "calibration file"), calibration.string());
 }
 
 }  // namespace
@@ -61,14 +76,8 @@ std::string recording_color_formats() {
 
 RecordingJson read_recording_json(const fs::path& folder) {
   const fs::path file = folder / "recording.json";
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read (is this a recording folder?)");
-  json document;
-  try {
-    document = json::parse(in);
-  } catch (const json::parse_error& error) {
-    throw Error(file.string() + ": malformed JSON: " + error.what());
-  }
+  if (!fs::exists(file)) throw Error(file.string() + ": cannot read (is this a recording folder?)");
+  const json document = parse_json(file, "recording.json");
   if (!document.is_object()) fail(file, "", "an object", document);
   for (const auto& [key, value] : document.items()) {
     if (key != "format" && key != "calibration" && key != "color_format" && key != "description") {
