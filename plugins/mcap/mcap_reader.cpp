@@ -75,8 +75,8 @@ McapReader::McapReader(std::filesystem::path file, Index index) : file_(std::mov
     throw Error(where("Header", kMagic.size()) + ": expected a Header record (opcode 1), found " +
                 std::to_string(header.opcode));
   }
-  RecordParser parser(read_bytes(header.content_offset(), header.length),
-                      where("Header", header.offset));
+  const std::string header_bytes = read_bytes(header.content_offset(), header.length);
+  RecordParser parser(header_bytes, where("Header", header.offset));
   parser.string("profile");
   library_ = parser.string("library");
   data_start_ = header.end();
@@ -169,8 +169,8 @@ bool McapReader::read_summary() {
       footer.length != kFooterContentSize) {
     return false;
   }
-  RecordParser parser(read_bytes(footer.content_offset(), footer.length),
-                      where("Footer", footer_offset));
+  const std::string footer_bytes = read_bytes(footer.content_offset(), footer.length);
+  RecordParser parser(footer_bytes, where("Footer", footer_offset));
   const std::uint64_t summary_start = parser.u64("summary_start");
   parser.u64("summary_offset_start");
   const std::uint32_t summary_crc = parser.u32("summary_crc");
@@ -264,8 +264,8 @@ void McapReader::scan(std::string summary_problem) {
       if (record.opcode == static_cast<std::uint8_t>(Opcode::kDataEnd) ||
           record.opcode == static_cast<std::uint8_t>(Opcode::kFooter)) {
         if (record.opcode == static_cast<std::uint8_t>(Opcode::kDataEnd)) {
-          RecordParser content(read_bytes(record.content_offset(), record.length),
-                               where("DataEnd", offset));
+          const std::string bytes = read_bytes(record.content_offset(), record.length);
+          RecordParser content(bytes, where("DataEnd", offset));
           data_end_ = DataEnd{offset, content.u32("data_section_crc")};
         }
         recovery.stop_reason =

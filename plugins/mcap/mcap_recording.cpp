@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "mcap_reader.h"
@@ -161,19 +162,26 @@ RepairResult repair_recording(const std::filesystem::path& input,
     options.chunk_size = std::numeric_limits<std::uint64_t>::max();  // as the input's chunks
     options.library = reader.library();
     McapWriter writer(temporary, options);
+    // Damage in the input is dropped and reported; an error writing the output is not.
     for (const AttachmentIndex& index : reader.attachments()) {
+      std::optional<Attachment> attachment;
       try {
-        writer.add_attachment(reader.read_attachment(index));
+        attachment = reader.read_attachment(index);
       } catch (const Error& damaged) {
         result.dropped.push_back({index.offset, index.length, damaged.what()});
+        continue;
       }
+      writer.add_attachment(*attachment);
     }
     for (const MetadataIndex& index : reader.metadata()) {
+      std::optional<Metadata> metadata;
       try {
-        writer.add_metadata(reader.read_metadata(index));
+        metadata = reader.read_metadata(index);
       } catch (const Error& damaged) {
         result.dropped.push_back({index.offset, index.length, damaged.what()});
+        continue;
       }
+      writer.add_metadata(*metadata);
     }
     // Channels (and their schemas) as the output first needs them: a chunk may define
     // its own.

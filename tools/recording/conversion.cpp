@@ -11,6 +11,7 @@
 #include "output_path.h"
 #include "recording_layout.h"
 #include "tilth/error.h"
+#include "tilth/regular_file.h"
 
 namespace tilth::tools {
 namespace {
@@ -63,9 +64,12 @@ void connect_recording_ports(InProcessGraph& graph) {
 // `scratch`; the rest of recording.json is the source stage's to check.
 fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scratch) {
   const fs::path file = folder / "recording.json";
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read (is this an image-folder recording?)");
-  const json recording = json::parse(in, nullptr, false);
+  if (!fs::exists(file)) {
+    throw Error(file.string() + ": cannot read (is this an image-folder recording?)");
+  }
+  constexpr std::uint64_t kMaxBytes = 16 << 20;  // as the source stage reads it
+  const json recording =
+      json::parse(read_regular_file(file, kMaxBytes, "recording.json"), nullptr, false);
   if (recording.is_discarded() || !recording.is_object()) {
     throw Error(file.string() + ": expected a JSON object (spec: tilth-image-folder/1)");
   }
