@@ -185,15 +185,18 @@ TEST_F(McapRecoveryTest, AForgedUncompressedSizeIsALocatedErrorThatCostsNoMemory
   }
 }
 
-// Every byte of the summary, the Footer and the closing magic: a flipped bit there
-// leaves every chunk readable, found by scanning the data section.
+// A flipped bit in the summary, the Footer or the closing magic (every byte of the last
+// 64, the Footer's, every 8th before) leaves every chunk readable, found by scanning the
+// data section.
 TEST_F(McapRecoveryTest, AFlippedBitInTheSummaryFallsBackToAScan) {
   const std::string original = read_text(complete_);
   std::uint64_t summary_start = 0;
   std::memcpy(&summary_start, original.data() + original.size() - 8 - 20, 8);
   ASSERT_GT(summary_start, chunks_.back().chunk_start_offset);
   const fs::path file = dir_.path() / "flipped.mcap";
-  for (std::uint64_t offset = summary_start; offset < original.size(); ++offset) {
+  const std::uint64_t tail = original.size() - 64;
+  for (std::uint64_t offset = summary_start; offset < original.size();
+       offset += offset < tail ? 8 : 1) {
     SCOPED_TRACE("bit flipped at offset " + std::to_string(offset));
     write_text(file, original);
     flip_bit(file, offset);

@@ -42,9 +42,10 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Replaces `file` with a FIFO that nothing writes to. Should the code under test block
-// opening or reading it, the writing end is opened and closed after 3 s, so that the
-// test fails (an end of file instead of the expected error) rather than hangs.
+// Replaces `file` with a FIFO that nothing writes to, removed again at the end of the
+// scope. Should the code under test block opening or reading it, the writing end is
+// opened and closed after 3 s, so that the test fails (an end of file instead of the
+// expected error) rather than hangs.
 class Fifo {
  public:
   explicit Fifo(const fs::path& file) : file_(file) {
@@ -64,6 +65,7 @@ class Fifo {
   ~Fifo() {
     done_ = true;
     unblocker_.join();
+    fs::remove(file_);
   }
   Fifo(const Fifo&) = delete;
   Fifo& operator=(const Fifo&) = delete;
@@ -517,7 +519,6 @@ TEST_F(ImageFolderSourceTest, AFifoOrDeviceInTheRecordingIsRefusedNotWaitedFor) 
                 (folder_ / name).string() + ": is a FIFO; expected a regular file (" + what + ")");
       EXPECT_LT(seconds_since(start), 2.0);
     }
-    fs::remove(folder_ / name);
     record(3);
   }
   fs::remove(folder_ / "frames.csv");

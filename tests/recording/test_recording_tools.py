@@ -171,6 +171,12 @@ class Simulate(unittest.TestCase):
         result = tilth("simulate", existing, "--calibration", self.rig)
         self.assertEqual(result.returncode, 1)
         self.assertIn(existing + ": exists; use --overwrite to replace it", result.stderr)
+        # --overwrite replaces a recording, not any file.
+        result = tilth("simulate", existing, "--calibration", self.rig, "--overwrite")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn(existing + ": exists and is not an MCAP file", result.stderr)
+        self.assertEqual(read_bytes(existing), b"not a recording")
+        open(existing, "w").close()
         self.assertEqual(tilth("simulate", existing, "--calibration", self.rig, "--preset", "flat",
                                "--frames", 1, "--overwrite").returncode, 0)
         self.assertEqual(read_bytes(existing)[:8], MCAP_MAGIC)
@@ -255,7 +261,7 @@ class Recording(unittest.TestCase):
     def test_no_output_is_written_over_its_input_or_anything_but_a_recording(self):
         calibration = small_calibration()
         source = self.path("in")
-        write_input_recording(source, make_frames(2, 1, calibration), "bgr8", calibration)
+        write_input_recording(source, make_frames(2, 3, calibration), "bgr8", calibration)
         mcap = self.path("in.mcap")
         self.assertEqual(tilth("recording", "import", source, mcap).returncode, 0)
         folder_files = {name: read_bytes(os.path.join(source, name))

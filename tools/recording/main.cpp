@@ -60,8 +60,9 @@ int info(const CommandLine& line) {
   const tilth::mcap::RecordingInfo recording = tilth::mcap::recording_info(file);
   std::cout << tilth::mcap::format_info(recording);
   if (recording.problems.empty()) return kExitOk;
-  std::cerr << "tilth recording: " << file.string() << ": damaged (" << recording.problems.size()
-            << " problems, listed under integrity); `tilth recording repair` salvages it\n";
+  std::cerr << "tilth recording: " << file.string()
+            << ": damaged (listed under integrity: " << recording.problems.size()
+            << "); `tilth recording repair` salvages it\n";
   return kExitDamaged;
 }
 
