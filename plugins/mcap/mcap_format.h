@@ -14,6 +14,9 @@ namespace tilth::mcap {
 inline constexpr std::array<char, 8> kMagic{'\x89', 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 // Opcode (1 byte) and content length (8 bytes) before every record's content.
 inline constexpr std::uint64_t kRecordPrefixSize = 9;
+// The most a chunk's records may hold uncompressed: mcap.writer's chunks are its
+// chunk_size (at most 100 MB) plus one frame; a larger size is damaged or forged.
+inline constexpr std::uint64_t kMaxChunkRecordsSize = std::uint64_t{1} << 30;
 // The Footer's content: summary_start, summary_offset_start, summary_crc.
 inline constexpr std::uint64_t kFooterContentSize = 8 + 8 + 4;
 

@@ -14,8 +14,10 @@
 // are played and a warning says how much was recovered.
 #include <algorithm>
 #include <deque>
+#include <iomanip>
 #include <limits>
 #include <optional>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -52,6 +54,12 @@ std::uint64_t seconds_to_ns(double seconds) {
   return static_cast<std::uint64_t>(seconds * 1e9 + 0.5);
 }
 
+std::string seconds_text(double seconds) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(3) << seconds << " s";
+  return text.str();
+}
+
 RigCalibration read_calibration(McapReader& reader) {
   const std::optional<Attachment> attachment = reader.find_attachment(kCalibrationAttachment);
   if (!attachment) {
@@ -86,12 +94,19 @@ class McapPlayer final : public Source {
       if (image_channel) check_image_channel(reader_.channels().at(*image_channel));
     }
     if (const auto& recovery = reader_.recovery()) {
-      log_.warning(reader_.file().string() +
-                   ": no summary (the recording was cut off while "
-                   "written?); recovered " +
+      const std::string why = recovery->summary_problem.empty()
+                                  ? "no summary (the recording was cut off while written?)"
+                                  : "summary not used (" + recovery->summary_problem + ")";
+      log_.warning(reader_.file().string() + ": " + why + "; recovered " +
                    std::to_string(reader_.chunks().size()) + " complete chunks, " +
                    std::to_string(recovery->readable_bytes) + " of " +
                    std::to_string(reader_.file_size()) + " bytes; " + recovery->stop_reason);
+      for (const DamagedRange& range : recovery->skipped) {
+        if (range.offset + range.size == reader_.file_size()) break;  // the rest: said above
+        log_.warning(reader_.file().string() + ": skipped " + std::to_string(range.size) +
+                     " damaged bytes at offset " + std::to_string(range.offset) + " (" +
+                     range.reason + ")");
+      }
     }
     select_chunks(context.params.number("start_s"), context.params.number("end_s"));
   }
@@ -127,19 +142,29 @@ class McapPlayer final : public Source {
   // that overlap it.
   void select_chunks(double start_s, double end_s) {
     std::uint64_t first = std::numeric_limits<std::uint64_t>::max();
+    std::uint64_t last = 0;
     if (reader_.statistics() && reader_.statistics()->message_count > 0) {
       first = reader_.statistics()->message_start_time;
+      last = reader_.statistics()->message_end_time;
     } else {
       for (const ChunkIndex& chunk : reader_.chunks()) {
         first = std::min(first, chunk.message_start_time);
+        last = std::max(last, chunk.message_end_time);
       }
     }
-    start_ns_ = first + seconds_to_ns(start_s);
-    end_ns_ = end_s > 0 ? first + seconds_to_ns(end_s) : std::numeric_limits<std::uint64_t>::max();
+    const double duration_s = first <= last ? static_cast<double>(last - first) * 1e-9 : 0.0;
+    if (start_s > duration_s) {
+      throw Error(reader_.file().string() + ": start_s " + seconds_text(start_s) +
+                  " is past the recording's end: it lasts " + seconds_text(duration_s) +
+                  " (log time of its first to its last message); expected start_s <= that");
+    }
     if (end_s > 0 && end_s < start_s) {
       throw Error("end_s " + std::to_string(end_s) + ": expected 0 (the end) or >= start_s " +
                   std::to_string(start_s));
     }
+    start_ns_ = first + seconds_to_ns(start_s);
+    end_ns_ = end_s > 0 && end_s <= duration_s ? first + seconds_to_ns(end_s)
+                                               : std::numeric_limits<std::uint64_t>::max();
     for (const ChunkIndex& chunk : reader_.chunks()) {
       if (chunk.message_end_time < start_ns_ || chunk.message_start_time > end_ns_) continue;
       chunks_.push_back(chunk);

@@ -1,5 +1,6 @@
-// What the command line does with an MCAP recording: `tilth recording info FILE` and
-// `tilth recording repair FILE`.
+// What the command line does with an MCAP recording: `tilth recording info FILE`, which
+// checks every CRC, and `tilth recording repair FILE OUTPUT`, which salvages every
+// intact chunk into a new file.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "mcap_reader.h"
 
 namespace tilth::mcap {
 
@@ -20,10 +23,15 @@ struct ChannelInfo {
 
 struct RecordingInfo {
   std::uint64_t file_size = 0;
-  bool has_summary = false;
+  bool has_summary = false;     // read from an intact summary
+  std::string summary_problem;  // why a summary the file has was not used; "" = none
   // Without a summary: the bytes from the start that are readable, and why the rest is not.
   std::uint64_t readable_bytes = 0;
   std::string stop_reason;
+  // Everything that keeps the file from being intact, one line each: a missing or
+  // damaged summary, damaged bytes the scan skipped, chunks, attachments or metadata
+  // that fail their CRC or cannot be read, a data section CRC that does not match.
+  std::vector<std::string> problems;
   std::string library;
   std::vector<ChannelInfo> channels;
   std::uint64_t message_count = 0;
@@ -38,7 +46,9 @@ struct RecordingInfo {
   double duration_s() const { return static_cast<double>(end_time_ns - start_time_ns) * 1e-9; }
 };
 
-// From the summary when the file has one; otherwise by reading every recoverable chunk.
+// Reads every chunk, attachment and metadata record (checking their CRCs) and the data
+// section's CRC when the file has one; the indexes from the summary when it is intact,
+// otherwise from a scan of the data section.
 RecordingInfo recording_info(const std::filesystem::path& file);
 // Lines of text for a terminal.
 std::string format_info(const RecordingInfo& info);
@@ -46,12 +56,17 @@ std::string format_info(const RecordingInfo& info);
 struct RepairResult {
   std::uint64_t chunks = 0;
   std::uint64_t messages = 0;
-  std::uint64_t lost_bytes = 0;  // after the last complete record of the input
+  // What of the input the output lacks, in file order: damaged or cut-off bytes, chunks
+  // that fail their CRC, unreadable attachments and metadata.
+  std::vector<DamagedRange> dropped;
+  std::uint64_t lost_bytes = 0;  // their total
 };
 
-// Writes `output` (which may be `input`: it is then replaced once complete) with the
-// attachments, metadata, channels and every complete chunk of `input`, chunk by chunk
-// as they were, and a summary.
+// Writes `output` with the attachments, metadata, channels and every intact chunk of
+// `input`, found by scanning its data section (resynchronising after damage; the
+// summary is not trusted), chunk by chunk as they were, and a summary. The output is
+// written beside itself and renamed into place once complete; `output` may not be
+// `input`: the input is never written.
 RepairResult repair_recording(const std::filesystem::path& input,
                               const std::filesystem::path& output);
 

@@ -203,7 +203,7 @@ StageDescriptor describe() {
                     "whose host time is not a capture time, such as an image folder without "
                     "host_timestamps.csv replays)"),
       ParamSpec::integer("chunk_size", 4 * 1024 * 1024)
-          .range(1, std::nullopt)
+          .range(1, 100'000'000)
           .in_unit("bytes")
           .describe("a chunk is closed after the frame that makes it this large"),
       ParamSpec::path("calibration", std::nullopt)

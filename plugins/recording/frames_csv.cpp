@@ -3,9 +3,10 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <limits>
 #include <string_view>
 
+#include "text_lines.h"
 #include "tilth/error.h"
 
 namespace tilth::recording {
@@ -60,6 +61,12 @@ class LineReader {
   Integer integer(Column column, std::string_view text, const std::string& expected) const {
     Integer value{};
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::result_out_of_range) {
+      fail(column,
+           expected + " from " + std::to_string(std::numeric_limits<Integer>::min()) + " to " +
+               std::to_string(std::numeric_limits<Integer>::max()),
+           text);
+    }
     if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
       fail(column, expected, text);
     }
@@ -127,20 +134,22 @@ void check_increasing(const LineReader& reader, Column column, Value previous, V
 }  // namespace
 
 std::vector<FrameEntry> read_frames_csv(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read (is this a recording folder?)");
-  std::string text;
-  if (!std::getline(in, text))
+  if (!fs::exists(file)) throw Error(file.string() + ": cannot read (is this a recording folder?)");
+  TextLines lines(file, {kMaxFramesCsvBytes, kMaxFramesCsvLine}, "frames.csv");
+  std::string_view text;
+  if (!lines.next(text))
     throw Error(file.string() + ":1: expected the header line, got an empty file");
-  // Tolerate files written on Windows.
-  if (!text.empty() && text.back() == '\r') text.pop_back();
   const ColumnPositions positions = read_header(file, text);
   const std::size_t field_count = split(text).size();
 
   std::vector<FrameEntry> entries;
-  for (std::size_t line = 2; std::getline(in, text); ++line) {
-    if (!text.empty() && text.back() == '\r') text.pop_back();
+  while (lines.next(text)) {
+    const std::size_t line = lines.number();
     if (text.empty()) continue;
+    if (entries.size() == kMaxFrames) {
+      throw Error(file.string() + ":" + std::to_string(line) + ": more than " +
+                  std::to_string(kMaxFrames) + " frames; expected at most that many");
+    }
     const LineReader reader(file, line);
     const auto fields = split(text);
     if (fields.size() != field_count) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tilth::recording {
@@ -14,6 +15,13 @@ namespace tilth::recording {
 // The header the writer writes: every column, in the spec's order.
 inline constexpr std::string_view kFramesCsvHeader =
     "index,depth_timestamp_ns,color_timestamp_ns,depth,color,mask,ground_truth_mm";
+
+// What a frames.csv may hold: 1 000 000 frames is over 9 hours at 30 frames/s (and
+// about 4.5 TB of PNGs at the paper rig's sizes), and 128 MiB and lines of 16 KiB leave
+// room for long paths.
+inline constexpr std::size_t kMaxFrames = 1'000'000;
+inline constexpr std::uint64_t kMaxFramesCsvBytes = 128 << 20;
+inline constexpr std::size_t kMaxFramesCsvLine = 16 << 10;
 
 struct FrameEntry {
   std::size_t line = 0;  // in frames.csv, counting the header as line 1
@@ -27,8 +35,9 @@ struct FrameEntry {
 };
 
 // Reads every line; throws tilth::Error naming the file, the line and what was expected
-// for a missing or unknown column, a malformed field, or an index or timestamp that
-// does not increase.
+// for a missing or unknown column, a malformed or out-of-range field, an index or
+// timestamp that does not increase, or a file beyond the limits above (or not a regular
+// file).
 std::vector<FrameEntry> read_frames_csv(const std::filesystem::path& file);
 
 // One line of frames.csv, without the newline, in kFramesCsvHeader's column order.

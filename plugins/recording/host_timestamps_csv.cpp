@@ -1,15 +1,17 @@
 #include "host_timestamps_csv.h"
 
 #include <charconv>
-#include <fstream>
 #include <optional>
 
+#include "text_lines.h"
 #include "tilth/error.h"
 
 namespace tilth::recording {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxLineBytes = 64;
 
 struct Line {
   std::uint64_t index = 0;
@@ -63,24 +65,22 @@ class LineReader {
 
 std::vector<std::int64_t> read_host_timestamps(const fs::path& file,
                                                const std::vector<FrameEntry>& frames) {
-  std::ifstream in(file);
-  if (!in) throw Error(file.string() + ": cannot read");
-  std::string text;
-  if (!std::getline(in, text)) {
+  // One line per frame of frames.csv, of at most two 20-digit numbers, and one more.
+  TextLines lines(file, {(kMaxFrames + 2) * kMaxLineBytes, kMaxLineBytes}, "host_timestamps.csv");
+  std::string_view text;
+  if (!lines.next(text)) {
     throw Error(file.string() + ":1: expected the header '" + std::string(kHostTimestampsHeader) +
                 "', got an empty file");
   }
-  // Tolerate files written on Windows, as frames.csv does.
-  if (!text.empty() && text.back() == '\r') text.pop_back();
   if (text != kHostTimestampsHeader) {
     LineReader(file, 1).fail("expected the header '" + std::string(kHostTimestampsHeader) +
-                             "', got '" + text + "'");
+                             "', got '" + std::string(text) + "'");
   }
 
   std::vector<std::int64_t> host_timestamps;
   bool after_last_frame = false;
-  for (std::size_t line = 2; std::getline(in, text); ++line) {
-    if (!text.empty() && text.back() == '\r') text.pop_back();
+  while (lines.next(text)) {
+    const std::size_t line = lines.number();
     if (text.empty()) continue;
     const LineReader reader(file, line);
     const Line read = reader.read(text);

@@ -4,7 +4,8 @@
 // host capture times of host_timestamps.csv when the folder has one. recording.json, all
 // of frames.csv and host_timestamps.csv are checked before the first frame, whichever
 // host times are used, so a malformed recording fails before the graph runs; the PNGs
-// are read frame by frame.
+// are read frame by frame. Every file is read only when it is a regular file (a FIFO or
+// a device named in a recording would block the replay) within a size limit.
 #include <optional>
 
 #include <opencv2/imgcodecs.hpp>
@@ -18,6 +19,7 @@
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
+#include "tilth/regular_file.h"
 #include "tilth/replay_host_time.h"
 
 namespace tilth::recording {
@@ -28,6 +30,9 @@ namespace fs = std::filesystem;
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
+// A PNG of the largest image a rig gives (16-bit 1280x1024x3: 7.5 MiB raw) with room
+// for PNG's worst case; a larger file is not a frame of a recording.
+constexpr std::uint64_t kMaxImageBytes = 256 << 20;
 
 // Each frame's host capture time from host_timestamps.csv; none without the file.
 std::vector<std::int64_t> recorded_host_timestamps(const fs::path& folder,
@@ -117,8 +122,19 @@ class ImageFolderSource final : public Source {
     if (!fs::exists(file)) {
       problem = "no such file";
     } else {
-      image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-      if (image.empty()) problem = "not a readable image";
+      try {
+        const std::string bytes = read_regular_file(file, kMaxImageBytes, "PNG image");
+        if (!bytes.empty()) {
+          image = cv::imdecode(
+              cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+              cv::IMREAD_UNCHANGED);
+        }
+        if (image.empty()) problem = "not a readable image";
+      } catch (const Error& error) {
+        const std::string prefix = file.string() + ": ";
+        const std::string text = error.what();
+        problem = text.starts_with(prefix) ? text.substr(prefix.size()) : text;
+      }
     }
     if (!problem.empty()) {
       if (stop_on_missing_) throw Error(where + ": " + problem + " (on_missing: stop)");

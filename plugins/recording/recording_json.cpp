@@ -40,7 +40,10 @@ RigCalibration read_calibration(const json& value, const fs::path& folder, const
     fail(file, "/calibration",
          "a calibration file name relative to the folder, or a calibration object", value);
   }
-  return load_calibration(folder / value.get<std::string>());
+  const fs::path calibration = folder / value.get<std::string>();
+  return parse_calibration(
+      parse_json(read_json_text(calibration, "calibration file"), calibration.string()),
+      calibration.string());
 }
 
 }  // namespace

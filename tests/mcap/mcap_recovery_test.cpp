@@ -1,6 +1,12 @@
 // A recording cut off mid-write (power loss, kill -9) plays up to its last complete
 // chunk with a warning saying how much was recovered, and `repair` rewrites it with a
-// summary; a chunk whose CRC does not match is reported with its file offset.
+// summary; a chunk whose CRC does not match is reported with its file offset. Damage
+// elsewhere: a forged size costs no memory and is a located error; a damaged summary
+// is read around by scanning; `repair` salvages every intact chunk around a damaged one
+// into a new file and says what it dropped; `info` checks every CRC.
+#include <sys/resource.h>
+
+#include <cstring>
 #include <fstream>
 
 #include "mcap_fixture.h"
@@ -17,6 +23,32 @@ void copy_prefix(const fs::path& from, const fs::path& to, std::uint64_t size) {
   std::string bytes = read_text(from);
   ASSERT_LE(size, bytes.size());
   std::ofstream(to, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(size));
+}
+
+// Writes `bytes` over the file's bytes at `offset`.
+void patch(const fs::path& file, std::uint64_t offset, std::string_view bytes) {
+  std::fstream out(file, std::ios::in | std::ios::out | std::ios::binary);
+  out.seekp(static_cast<std::streamoff>(offset));
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good());
+}
+
+std::string u64_bytes(std::uint64_t value) {
+  std::string bytes(8, '\0');
+  std::memcpy(bytes.data(), &value, 8);
+  return bytes;
+}
+
+void flip_bit(const fs::path& file, std::uint64_t offset) {
+  const std::string bytes = read_text(file);
+  patch(file, offset, std::string(1, static_cast<char>(bytes.at(offset) ^ 0x01)));
+}
+
+// The peak resident memory of this process so far.
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
 }
 
 class McapRecoveryTest : public McapTest {
@@ -91,14 +123,188 @@ TEST_F(McapRecoveryTest, RepairInPlaceAndInfoOfACutFile) {
   EXPECT_EQ(before.message_count, 4u + 2u + 4u);  // frames without truth have no /truth
   EXPECT_NE(mcap::format_info(before).find("summary:     MISSING"), std::string::npos);
 
-  const mcap::RepairResult result = mcap::repair_recording(file, file);
+  const std::string cut_bytes = read_text(file);
+  try {
+    mcap::repair_recording(file, dir_.path() / "." / "cut.mcap");
+    ADD_FAILURE() << "repaired in place";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("never writes over its input"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(read_text(file), cut_bytes);
+
+  const fs::path repaired = dir_.path() / "repaired.mcap";
+  const mcap::RepairResult result = mcap::repair_recording(file, repaired);
   EXPECT_EQ(result.lost_bytes, 100u);
-  const mcap::RecordingInfo after = mcap::recording_info(file);
+  ASSERT_EQ(result.dropped.size(), 1u);
+  EXPECT_EQ(result.dropped[0].offset, chunks_[3].chunk_start_offset);
+  EXPECT_EQ(read_text(file), cut_bytes);
+  const mcap::RecordingInfo after = mcap::recording_info(repaired);
   EXPECT_TRUE(after.has_summary);
+  EXPECT_TRUE(after.problems.empty());
   EXPECT_EQ(after.message_count, before.message_count);
   EXPECT_EQ(after.start_time_ns, before.start_time_ns);
   EXPECT_EQ(after.end_time_ns, before.end_time_ns);
-  EXPECT_FALSE(fs::exists(file.string() + ".repairing"));
+  EXPECT_FALSE(fs::exists(repaired.string() + ".repairing"));
+}
+
+// 4.26 GB asked for by a 1.25 MB file once; larger sizes threw a bare std::bad_alloc.
+TEST_F(McapRecoveryTest, AForgedUncompressedSizeIsALocatedErrorThatCostsNoMemory) {
+  for (const std::string compression : {"zstd", "lz4", "none"}) {
+    SCOPED_TRACE(compression);
+    const fs::path file = dir_.path() / (compression + ".mcap");
+    ASSERT_FALSE(
+        record(file, PixelFormat::kBgr8, {{"chunk_size", 1}, {"compression", compression}}).failed);
+    mcap::McapReader reader(file);
+    const mcap::ChunkIndex chunk = reader.chunks()[1];
+    const std::string place =
+        file.string() + ": Chunk at offset " + std::to_string(chunk.chunk_start_offset) + ": ";
+    // uncompressed_size: after the prefix, message_start_time and message_end_time.
+    const std::uint64_t size_offset = chunk.chunk_start_offset + mcap::kRecordPrefixSize + 16;
+    const std::uint64_t peak_before = peak_rss_bytes();
+    patch(file, size_offset, u64_bytes(512u << 20));
+    try {
+      reader.read_chunk(chunk);
+      ADD_FAILURE() << "read a chunk with a forged size";
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(place + "expected 536870912"), std::string::npos)
+          << error.what();
+    }
+    EXPECT_LT(peak_rss_bytes() - peak_before, 64u << 20);
+    patch(file, size_offset, u64_bytes(std::uint64_t{1} << 40));
+    try {
+      reader.read_chunk(chunk);
+      ADD_FAILURE() << "read a chunk with a forged size";
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what())
+                    .find(place + "uncompressed_size 1099511627776 exceeds "
+                                  "1073741824 bytes, the most a chunk may hold"),
+                std::string::npos)
+          << error.what();
+    }
+  }
+}
+
+// A flipped bit in the summary, the Footer or the closing magic (every byte of the last
+// 64, the Footer's, every 8th before) leaves every chunk readable, found by scanning the
+// data section.
+TEST_F(McapRecoveryTest, AFlippedBitInTheSummaryFallsBackToAScan) {
+  const std::string original = read_text(complete_);
+  std::uint64_t summary_start = 0;
+  std::memcpy(&summary_start, original.data() + original.size() - 8 - 20, 8);
+  ASSERT_GT(summary_start, chunks_.back().chunk_start_offset);
+  const fs::path file = dir_.path() / "flipped.mcap";
+  const std::uint64_t tail = original.size() - 64;
+  for (std::uint64_t offset = summary_start; offset < original.size();
+       offset += offset < tail ? 8 : 1) {
+    SCOPED_TRACE("bit flipped at offset " + std::to_string(offset));
+    write_text(file, original);
+    flip_bit(file, offset);
+    mcap::McapReader reader(file);
+    ASSERT_EQ(reader.chunks().size(), chunks_.size());
+    std::size_t messages = 0;
+    for (const mcap::ChunkIndex& chunk : reader.chunks())
+      messages += reader.read_chunk(chunk).size();
+    EXPECT_EQ(messages, 4u + 2u + 4u + 2u + 4u + 2u);
+    EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
+  }
+  write_text(file, original);
+  flip_bit(file, summary_start + 40);
+  const RunResult played = play(file, {{"host_time", "recorded"}});
+  ASSERT_FALSE(played.failed) << played.failure;
+  expect_played(PixelFormat::kBgr8, 0, frames_.size());
+  EXPECT_TRUE(warned(file.string() + ": summary not used (" + file.string() +
+                     ": summary section at offset " + std::to_string(summary_start) +
+                     ": CRC mismatch"));
+  EXPECT_NE(mcap::format_info(mcap::recording_info(file)).find("summary:     DAMAGED"),
+            std::string::npos);
+}
+
+// 3 of 30 chunks were kept once, in place, with exit code 0.
+TEST_F(McapRecoveryTest, RepairKeepsEveryIntactChunkAroundADamagedLength) {
+  frames_ = make_frames(30, small_calibration(), 3);
+  const fs::path file = dir_.path() / "thirty.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"chunk_size", 1}}).failed);
+  const std::vector<mcap::ChunkIndex> chunks = mcap::McapReader(file).chunks();
+  ASSERT_EQ(chunks.size(), 30u);
+  const mcap::ChunkIndex& damaged = chunks[3];
+  const std::string original = read_text(file);
+  // Too long for the file, then shorter than the chunk.
+  for (const std::uint64_t length : {std::uint64_t{1} << 40, damaged.chunk_length - 100}) {
+    SCOPED_TRACE("length " + std::to_string(length));
+    write_text(file, original);
+    patch(file, damaged.chunk_start_offset + 1, u64_bytes(length));
+    const std::string input = read_text(file);
+
+    const mcap::RecordingInfo info = mcap::recording_info(file);
+    ASSERT_EQ(info.problems.size(), 1u);
+    EXPECT_NE(
+        info.problems[0].find("Chunk at offset " + std::to_string(damaged.chunk_start_offset)),
+        std::string::npos)
+        << info.problems[0];
+
+    const fs::path repaired = dir_.path() / "repaired.mcap";
+    const mcap::RepairResult result = mcap::repair_recording(file, repaired);
+    EXPECT_EQ(read_text(file), input);
+    EXPECT_EQ(result.chunks, 29u);
+    ASSERT_EQ(result.dropped.size(), 1u);
+    EXPECT_EQ(result.dropped[0].offset, damaged.chunk_start_offset);
+    // The chunk and its MessageIndex records, up to the next chunk.
+    EXPECT_EQ(result.lost_bytes, chunks[4].chunk_start_offset - damaged.chunk_start_offset);
+    EXPECT_TRUE(mcap::recording_info(repaired).problems.empty());
+    ASSERT_FALSE(play(repaired, {{"host_time", "recorded"}}).failed);
+    std::vector<std::uint64_t> expected;
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      if (i != 3) expected.push_back(frames_[i].index);
+    }
+    EXPECT_EQ(captured_ids(), expected);
+  }
+}
+
+TEST_F(McapRecoveryTest, InfoAndRepairNameAChunkThatFailsItsCrc) {
+  const fs::path file = dir_.path() / "crc.mcap";
+  ASSERT_FALSE(
+      record(file, PixelFormat::kBgr8, {{"chunk_size", 1}, {"compression", "none"}}).failed);
+  const mcap::ChunkIndex chunk = mcap::McapReader(file).chunks()[2];
+  flip_bit(file, chunk.chunk_start_offset + chunk.chunk_length - 40);
+  const std::string crc_error =
+      "Chunk at offset " + std::to_string(chunk.chunk_start_offset) + ": CRC mismatch";
+
+  const mcap::RecordingInfo info = mcap::recording_info(file);
+  ASSERT_EQ(info.problems.size(), 1u);
+  EXPECT_NE(info.problems[0].find(crc_error), std::string::npos) << info.problems[0];
+  EXPECT_NE(
+      mcap::format_info(info).find("integrity:   DAMAGED\n  " + file.string() + ": " + crc_error),
+      std::string::npos);
+
+  const mcap::RepairResult result = mcap::repair_recording(file, dir_.path() / "repaired.mcap");
+  EXPECT_EQ(result.chunks, frames_.size() - 1);
+  ASSERT_EQ(result.dropped.size(), 1u);
+  EXPECT_EQ(result.dropped[0].offset, chunk.chunk_start_offset);
+  EXPECT_EQ(result.lost_bytes, chunk.chunk_length);
+  EXPECT_NE(result.dropped[0].reason.find(crc_error), std::string::npos);
+}
+
+// Tilth writes no data section CRC (0); a file that has one is checked against it.
+TEST_F(McapRecoveryTest, InfoChecksTheDataSectionCrc) {
+  const std::optional<mcap::DataEnd> data_end = mcap::McapReader(complete_).data_end();
+  ASSERT_TRUE(data_end);
+  EXPECT_EQ(data_end->data_section_crc, 0u);
+  const std::uint32_t crc = mcap::McapReader(complete_).crc_of(0, data_end->offset);
+  std::string crc_bytes(4, '\0');
+  std::memcpy(crc_bytes.data(), &crc, 4);
+  patch(complete_, data_end->offset + mcap::kRecordPrefixSize, crc_bytes);
+  EXPECT_TRUE(mcap::recording_info(complete_).problems.empty());
+
+  // A log time in the first chunk's MessageIndex: nothing else covers it.
+  flip_bit(complete_, chunks_[0].chunk_start_offset + chunks_[0].chunk_length + 15);
+  const mcap::RecordingInfo info = mcap::recording_info(complete_);
+  ASSERT_EQ(info.problems.size(), 1u);
+  EXPECT_NE(info.problems[0].find(complete_.string() + ": data section CRC mismatch (stored " +
+                                  std::to_string(crc) + " in DataEnd at offset " +
+                                  std::to_string(data_end->offset)),
+            std::string::npos)
+      << info.problems[0];
 }
 
 TEST_F(McapRecoveryTest, CorruptChunkIsReportedWithItsOffset) {

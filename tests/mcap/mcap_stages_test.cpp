@@ -224,6 +224,26 @@ TEST_F(McapStagesTest, SeeksByLogTimeWithoutReadingTheChunksBefore) {
   EXPECT_TRUE(play(file).failed);
 }
 
+// A window that starts after the last frame would play nothing: the user mistyped, and
+// is told how long the recording is before the graph runs.
+TEST_F(McapStagesTest, AStartPastTheEndIsRefusedBeforeTheGraphRuns) {
+  frames_ = make_frames(10, small_calibration(), 3);  // log times 100 ms apart: 0.9 s
+  const fs::path file = dir_.path() / "short.mcap";
+  ASSERT_FALSE(record(file, PixelFormat::kBgr8, {{"chunk_size", 1}}).failed);
+  for (const double start_s : {0.95, 1e12}) {
+    SCOPED_TRACE(start_s);
+    const std::string error = start_error(player_graph(file, {{"start_s", start_s}}));
+    EXPECT_NE(
+        error.find(file.string() + ": start_s " + (start_s < 1 ? "0.950" : "1000000000000.000") +
+                   " s is past the recording's end: it lasts 0.900 s"),
+        std::string::npos)
+        << error;
+  }
+  const RunResult last = play(file, {{"start_s", 0.9}, {"host_time", "recorded"}});
+  ASSERT_FALSE(last.failed) << last.failure;
+  expect_played(PixelFormat::kBgr8, 9, 1);
+}
+
 // By the device times, the camera's rhythm: the host times of a recording made faster
 // than real time (a simulation) are 1 ms apart.
 TEST_F(McapStagesTest, PacesAtTheRecordedRateOfTheDeviceTimes) {

@@ -2,6 +2,11 @@
 // test writes itself, host capture times when played or from host_timestamps.csv, the
 // exact error for each kind of bad input, skipping or stopping on a missing PNG, pacing,
 // interrupting a paced wait, and looping.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <sstream>
@@ -16,6 +21,9 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
+
+constexpr std::string_view kFramesHeader =
+    "index,depth_timestamp_ns,color_timestamp_ns,depth,color,mask,ground_truth_mm";
 
 // Source -> capture sink.
 std::string replay_graph(const fs::path& folder, json params = json::object()) {
@@ -33,6 +41,40 @@ std::string replay_graph(const fs::path& folder, json params = json::object()) {
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+// Replaces `file` with a FIFO that nothing writes to, removed again at the end of the
+// scope. Should the code under test block opening or reading it, the writing end is
+// opened and closed after 3 s, so that the test fails (an end of file instead of the
+// expected error) rather than hangs.
+class Fifo {
+ public:
+  explicit Fifo(const fs::path& file) : file_(file) {
+    fs::remove(file_);
+    if (::mkfifo(file_.c_str(), 0600) != 0) throw std::runtime_error("mkfifo failed");
+    unblocker_ = std::thread([this] {
+      const auto deadline = Clock::now() + std::chrono::seconds(3);
+      while (!done_) {
+        if (Clock::now() > deadline) {
+          const int fd = ::open(file_.c_str(), O_WRONLY | O_NONBLOCK);
+          if (fd >= 0) ::close(fd);
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
+  }
+  ~Fifo() {
+    done_ = true;
+    unblocker_.join();
+    fs::remove(file_);
+  }
+  Fifo(const Fifo&) = delete;
+  Fifo& operator=(const Fifo&) = delete;
+
+ private:
+  const fs::path file_;
+  std::atomic<bool> done_{false};
+  std::thread unblocker_;
+};
 
 class ImageFolderSourceTest : public RecordingTest {
  protected:
@@ -459,6 +501,75 @@ TEST_F(ImageFolderSourceTest, MissingPngStopsWhenAsked) {
                                 " (frames.csv line 4): no such file (on_missing: stop); its "
                                 "stream ends here");
   EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4}));
+}
+
+// A FIFO (or a device) named by a recording blocked the replay for good, and SIGTERM
+// did not end it: only regular files are read.
+TEST_F(ImageFolderSourceTest, AFifoOrDeviceInTheRecordingIsRefusedNotWaitedFor) {
+  record(3);
+  {
+    const Fifo fifo(folder_ / "depth/000004.png");
+    const auto start = Clock::now();
+    const RunResult result = run(replay_graph(folder_, {{"on_missing", "stop"}}));
+    EXPECT_LT(seconds_since(start), 2.0);
+    EXPECT_EQ(result.failure, "node 'src' (recording.image_folder) failed: " +
+                                  (folder_ / "depth/000004.png").string() +
+                                  " (frames.csv line 3): is a FIFO; expected a regular file (PNG "
+                                  "image) (on_missing: stop); its stream ends here");
+    EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3}));
+  }
+  record(3);
+  for (const std::string name : {"frames.csv", "host_timestamps.csv", "recording.json"}) {
+    SCOPED_TRACE(name);
+    write_host_timestamps(folder_, frames_);
+    const std::string what = name == "recording.json" ? "recording.json" : name;
+    {
+      const Fifo fifo(folder_ / name);
+      const auto start = Clock::now();
+      EXPECT_EQ(start_failure(),
+                (folder_ / name).string() + ": is a FIFO; expected a regular file (" + what + ")");
+      EXPECT_LT(seconds_since(start), 2.0);
+    }
+    record(3);
+  }
+  fs::remove(folder_ / "frames.csv");
+  fs::create_symlink("/dev/null", folder_ / "frames.csv");
+  EXPECT_EQ(start_failure(),
+            csv() + ": is a character device; expected a regular file (frames.csv)");
+}
+
+TEST_F(ImageFolderSourceTest, FramesCsvBeyondItsLimitsIsALocatedError) {
+  record(3);
+  replace_line(3, "4,1100000000,1100400000,depth/" + std::string(20'000, 'x') + ".png,c,,");
+  EXPECT_EQ(start_failure(), csv() + ":3: a line of 20038 bytes; expected at most 16384");
+
+  record(3);
+  replace_line(3, "99999999999999999999,1100000000,1100400000,depth/000004.png,c,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":3: column 'index': expected a non-negative integer from 0 to "
+                                 "18446744073709551615, got '99999999999999999999'");
+  replace_line(3, "4,9223372036854775808,1100400000,depth/000004.png,c,,");
+  EXPECT_EQ(start_failure(), csv() +
+                                 ":3: column 'depth_timestamp_ns': expected an integer number of "
+                                 "nanoseconds from -9223372036854775808 to 9223372036854775807, "
+                                 "got '9223372036854775808'");
+
+  // Sparse: no disk is used.
+  record(3);
+  fs::resize_file(folder_ / "frames.csv", (128u << 20) + 1);
+  EXPECT_EQ(start_failure(), csv() +
+                                 ": is 134217729 bytes; expected at most 134217728 for a "
+                                 "frames.csv");
+
+  std::string lines(kFramesHeader);
+  lines += "\n";
+  for (int i = 0; i <= 1'000'000; ++i) {
+    const std::string n = std::to_string(i);
+    lines += n + "," + n + "," + n + ",d,c,,\n";
+  }
+  write_text(folder_ / "frames.csv", lines);
+  EXPECT_EQ(start_failure(),
+            csv() + ":1000002: more than 1000000 frames; expected at most that many");
 }
 
 // 10 frames 100 ms apart span 0.9 s of recorded time.

@@ -171,6 +171,12 @@ class Simulate(unittest.TestCase):
         result = tilth("simulate", existing, "--calibration", self.rig)
         self.assertEqual(result.returncode, 1)
         self.assertIn(existing + ": exists; use --overwrite to replace it", result.stderr)
+        # --overwrite replaces a recording, not any file.
+        result = tilth("simulate", existing, "--calibration", self.rig, "--overwrite")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn(existing + ": exists and is not an MCAP file", result.stderr)
+        self.assertEqual(read_bytes(existing), b"not a recording")
+        open(existing, "w").close()
         self.assertEqual(tilth("simulate", existing, "--calibration", self.rig, "--preset", "flat",
                                "--frames", 1, "--overwrite").returncode, 0)
         self.assertEqual(read_bytes(existing)[:8], MCAP_MAGIC)
@@ -252,12 +258,58 @@ class Recording(unittest.TestCase):
         self.assertEqual(read_bytes(self.path("out/host_timestamps.csv")),
                          read_bytes(os.path.join(source, "host_timestamps.csv")))
 
+    def test_no_output_is_written_over_its_input_or_anything_but_a_recording(self):
+        calibration = small_calibration()
+        source = self.path("in")
+        write_input_recording(source, make_frames(2, 3, calibration), "bgr8", calibration)
+        mcap = self.path("in.mcap")
+        self.assertEqual(tilth("recording", "import", source, mcap).returncode, 0)
+        folder_files = {name: read_bytes(os.path.join(source, name))
+                        for name in ("recording.json", "frames.csv")}
+        mcap_bytes = read_bytes(mcap)
+        notes = self.path("notes")
+        os.makedirs(notes)
+        with open(os.path.join(notes, "todo.txt"), "w") as f:
+            f.write("not a recording\n")
+        cases = [
+            (["import", source, os.path.join(source, "recording.json"), "--overwrite"],
+             re.escape(os.path.join(source, "recording.json")) + r": lies inside the input "),
+            (["import", source, source, "--overwrite"], re.escape(source) + r": is the input "),
+            (["import", os.path.join(self.dir, "in"), self.dir + "/", "--overwrite"],
+             r": holds the input "),
+            (["export", mcap, self.dir, "--overwrite"], re.escape(self.dir) + r": holds the input "),
+            (["import", source, os.path.join(notes, "todo.txt"), "--overwrite"],
+             r"todo.txt: exists and is not an MCAP file \(it does not start with the MCAP magic "
+             r"bytes\); --overwrite replaces only a recording"),
+            (["export", mcap, notes, "--overwrite"],
+             re.escape(notes) + r": exists and is not an image-folder recording \(no "
+                                r"recording.json\); --overwrite replaces only a recording"),
+            (["repair", mcap, mcap, "--overwrite"], re.escape(mcap) + r": is the input "),
+        ]
+        for args, message in cases:
+            with self.subTest(args=args):
+                result = tilth("recording", *args)
+                self.assertEqual(result.returncode, 1, result.stderr)
+                self.assertRegex(result.stderr, message)
+        for name, data in folder_files.items():
+            self.assertEqual(read_bytes(os.path.join(source, name)), data, name)
+        self.assertEqual(read_bytes(mcap), mcap_bytes)
+        self.assertEqual(read_bytes(os.path.join(notes, "todo.txt")), b"not a recording\n")
+        # What is a recording is replaced.
+        self.assertEqual(tilth("recording", "import", source, mcap, "--overwrite").returncode, 0)
+        self.assertEqual(tilth("recording", "export", mcap, self.path("out")).returncode, 0)
+        result = tilth("recording", "export", mcap, self.path("out"), "--overwrite")
+        self.assertEqual(result.returncode, 0, result.stderr)
+
     def test_bad_input_says_what_and_where(self):
         folder = self.path("folder")
         os.makedirs(folder)
         with open(os.path.join(folder, "frames.csv"), "w") as f:
             f.write("index\n")
         not_mcap = os.path.join(folder, "frames.csv")
+        taken = self.path("taken.mcap")
+        with open(taken, "w") as f:
+            f.write("taken")
         cases = [
             ([], 2, r"expected a command"),
             (["frobnicate"], 2, r"unknown command 'frobnicate'"),
@@ -268,12 +320,15 @@ class Recording(unittest.TestCase):
              re.escape(not_mcap) + r": not an MCAP file \(expected the magic bytes"),
             (["export", not_mcap, self.path("out")], 1, re.escape(not_mcap) + r": not an MCAP file"),
             (["export", not_mcap, folder], 1,
-             re.escape(folder) + r": exists and is not empty; use --overwrite to replace it"),
+             re.escape(folder) + r": holds the input " + re.escape(not_mcap) +
+             r"; expected an output apart from it"),
             (["import", folder, self.path("x.mcap")], 1,
              re.escape(folder) + r"/recording.json: cannot read \(is this an image-folder "
                                  r"recording\?\)"),
             (["import", folder, not_mcap], 1,
-             re.escape(not_mcap) + r": exists; use --overwrite to replace it"),
+             re.escape(not_mcap) + r": lies inside the input " + re.escape(folder)),
+            (["import", folder, taken], 1, re.escape(taken) + r": exists; use --overwrite to "
+                                                              r"replace it"),
         ]
         for args, code, message in cases:
             with self.subTest(args=args):

@@ -83,7 +83,8 @@ fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scrat
 
 std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder,
                                const ConversionOptions& options) {
-  check_output_path(folder, options.overwrite);
+  check_apart(mcap_file, folder);
+  check_output_path(folder, RecordingKind::kImageFolder, options.overwrite);
   const TemporaryFolder scratch;
   fs::path calibration;
   {
@@ -111,7 +112,8 @@ std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder
 
 std::uint64_t import_from_folder(const fs::path& folder, const fs::path& mcap_file,
                                  const ConversionOptions& options) {
-  check_output_path(mcap_file, options.overwrite);
+  check_apart(folder, mcap_file);
+  check_output_path(mcap_file, RecordingKind::kMcapFile, options.overwrite);
   const TemporaryFolder scratch;
   InProcessGraph graph("tilth recording import");
   graph.add_node("player", "recording.image_folder",

@@ -12,7 +12,7 @@
 namespace tilth::tools {
 
 struct ConversionOptions {
-  bool overwrite = false;   // replace an existing output
+  bool overwrite = false;   // replace an existing output that is a recording
   std::string compression;  // import: the MCAP chunk compression; "" = mcap.writer's default
 };
 

@@ -12,6 +12,7 @@
 #include "conversion.h"
 #include "framework/diagnostics.h"
 #include "mcap_recording.h"
+#include "output_path.h"
 #include "tilth/error.h"
 
 namespace {
@@ -22,51 +23,72 @@ using namespace tilth::cli;
 constexpr const char* kUsage = R"(usage: tilth recording COMMAND ARGS
 
   info FILE                 an MCAP recording's channels, message counts, duration,
-                            size, compression, attachments and metadata
-  repair FILE [OUTPUT]      rewrite an MCAP recording that was cut off while written
-                            (power loss, kill -9) with every complete chunk and a
-                            summary; OUTPUT defaults to FILE (replaced once complete)
+                            size, compression, attachments and metadata; checks
+                            every CRC and lists what is damaged
+  repair FILE OUTPUT        salvage an MCAP recording that was cut off while written
+        [--overwrite]       (power loss, kill -9) or damaged: every intact chunk and
+                            a summary into OUTPUT, a new file (never FILE itself)
   export FILE DIR           an MCAP recording to an image-folder recording
         [--overwrite]       (replace the recording in DIR)
   import DIR FILE           an image-folder recording to an MCAP recording
         [--compression zstd|lz4|none] [--overwrite]
 
-Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad usage.
+--overwrite replaces only a recording (an MCAP file, a folder with recording.json),
+and no output may be, hold or lie inside its input.
+
+Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad
+usage, 3 when info finds damage or repair had to leave data out (both say what).
 )";
+
+constexpr int kExitDamaged = 3;
 
 int usage_error(const std::string& message) {
   std::cerr << "tilth recording: " << message << "\n\n" << kUsage;
   return kExitUsage;
 }
 
-// info and repair take no options.
-bool has_options(const CommandLine& line) {
-  return line.flag("--overwrite") || line.value("--compression").has_value();
-}
-
 int info(const CommandLine& line) {
-  if (line.positional().size() != 2 || has_options(line)) return usage_error("info takes FILE");
+  if (line.positional().size() != 2 || line.flag("--overwrite") || line.value("--compression")) {
+    return usage_error("info takes FILE");
+  }
   const fs::path file = line.positional()[1];
   if (fs::is_directory(file)) {
     throw tilth::Error(file.string() +
                        ": is a folder; info reads MCAP files (an image-folder recording's index "
                        "is its frames.csv)");
   }
-  std::cout << tilth::mcap::format_info(tilth::mcap::recording_info(file));
-  return kExitOk;
+  const tilth::mcap::RecordingInfo recording = tilth::mcap::recording_info(file);
+  std::cout << tilth::mcap::format_info(recording);
+  if (recording.problems.empty()) return kExitOk;
+  std::cerr << "tilth recording: " << file.string()
+            << ": damaged (listed under integrity: " << recording.problems.size()
+            << "); `tilth recording repair` salvages it\n";
+  return kExitDamaged;
 }
 
 int repair(const CommandLine& line) {
   const auto& args = line.positional();
-  if ((args.size() != 2 && args.size() != 3) || has_options(line)) {
-    return usage_error("repair takes FILE [OUTPUT]");
+  if (args.size() != 3 || line.value("--compression")) {
+    return usage_error("repair takes FILE OUTPUT [--overwrite]");
   }
-  const fs::path output = args.size() == 3 ? args[2] : args[1];
-  const auto result = tilth::mcap::repair_recording(args[1], output);
+  const fs::path input = args[1];
+  const fs::path output = args[2];
+  tilth::tools::check_apart(input, output);
+  tilth::tools::check_output_path(output, tilth::tools::RecordingKind::kMcapFile,
+                                  line.flag("--overwrite"));
+  const auto result = tilth::mcap::repair_recording(input, output);
   std::cout << output.string() << ": " << result.messages << " messages in " << result.chunks
-            << " chunks, with a summary; " << result.lost_bytes
-            << " bytes after the last complete record were dropped\n";
-  return kExitOk;
+            << " chunks, with a summary\n";
+  if (result.dropped.empty()) return kExitOk;
+  for (const auto& range : result.dropped) {
+    std::cerr << "tilth recording: dropped " << range.size << " bytes at offset " << range.offset
+              << ": " << range.reason << "\n";
+  }
+  std::cerr << "tilth recording: " << input.string() << ": " << result.lost_bytes
+            << " bytes could not be salvaged (" << result.dropped.size()
+            << " damaged or cut-off parts, listed above); " << input.string()
+            << " is left as it was\n";
+  return kExitDamaged;
 }
 
 int convert(const CommandLine& line) {

@@ -97,7 +97,10 @@ int main(int argc, char** argv) {
   const bool live = paced(line.value("--fps"));
 
   try {
-    tilth::tools::check_output_path(output, overwrite);
+    tilth::tools::check_output_path(output,
+                                    format == "mcap" ? tilth::tools::RecordingKind::kMcapFile
+                                                     : tilth::tools::RecordingKind::kImageFolder,
+                                    overwrite);
     tilth::tools::InProcessGraph graph("tilth simulate");
     graph.add_node("scene", "synthetic.scene", {{"calibration", TILTH_DEFAULT_CALIBRATION}});
     if (format == "mcap") {

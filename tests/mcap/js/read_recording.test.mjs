@@ -6,7 +6,7 @@
 // host_timestamps.csv and image timestamps against frames.csv, and every pixel of the
 // first depth, colour and mask image against the PNGs.
 import assert from "node:assert/strict";
-import { execFileSync } from "node:child_process";
+import { execFileSync, spawnSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
@@ -152,16 +152,60 @@ test("the stream reader reads every record with valid CRCs", () => {
   assert.equal(counts.DataEnd, 1);
 });
 
+// Runs `tilth-recording ARGS`: its exit code and output.
+function recordingTool(...args) {
+  const result = spawnSync(RECORDING_TOOL, args, { encoding: "utf8", timeout: 120_000 });
+  return { code: result.status, stdout: result.stdout, stderr: result.stderr };
+}
+
 test("tilth recording info and repair", () => {
   const info = execFileSync(TILTH, ["recording", "info", file], { encoding: "utf8" });
   assert.match(info, /summary: {5}yes/);
+  assert.match(info, /integrity: {3}every CRC matches/);
   assert.match(info, new RegExp(`/tof/raw  ${FRAMES} messages  foxglove_msgs/msg/RawImage \\(cdr\\)`));
   const cut = path.join(dir, "cut.mcap");
   const bytes = fs.readFileSync(file);
   fs.writeFileSync(cut, bytes.subarray(0, bytes.length - 100));
-  assert.match(execFileSync(RECORDING_TOOL, ["info", cut], { encoding: "utf8" }), /summary: {5}MISSING/);
-  execFileSync(RECORDING_TOOL, ["repair", cut], { encoding: "utf8" });
-  assert.match(execFileSync(RECORDING_TOOL, ["info", cut], { encoding: "utf8" }), /summary: {5}yes/);
+  const cutInfo = recordingTool("info", cut);
+  assert.equal(cutInfo.code, 3);
+  assert.match(cutInfo.stdout, /summary: {5}MISSING/);
+  const repaired = path.join(dir, "repaired.mcap");
+  assert.equal(recordingTool("repair", cut, repaired).code, 0);  // only the summary was cut
+  assert.match(execFileSync(RECORDING_TOOL, ["info", repaired], { encoding: "utf8" }),
+               /summary: {5}yes/);
+});
+
+// One chunk of three fails its CRC: info names it, and repair writes the other two into
+// a new file that Foxglove's reader reads with every CRC checked, leaving the input as
+// it was.
+test("repair salvages the intact chunks, as @mcap/core reads them", async () => {
+  const reader = await openReader();
+  const chunks = [...reader.chunkIndexes].sort((a, b) => Number(a.chunkStartOffset - b.chunkStartOffset));
+  assert.equal(chunks.length, FRAMES);
+  const damaged = path.join(dir, "damaged.mcap");
+  const bytes = Buffer.from(fs.readFileSync(file));
+  const bad = chunks[1];
+  bytes[Number(bad.chunkStartOffset + bad.chunkLength) - 40] ^= 0x01;
+  fs.writeFileSync(damaged, bytes);
+
+  const info = recordingTool("info", damaged);
+  assert.equal(info.code, 3);
+  assert.match(info.stdout, new RegExp(`Chunk at offset ${bad.chunkStartOffset}: `));
+  const salvaged = path.join(dir, "salvaged.mcap");
+  const repair = recordingTool("repair", damaged, salvaged);
+  assert.equal(repair.code, 3, repair.stderr);
+  assert.match(repair.stderr, new RegExp(`dropped ${bad.chunkLength} bytes at offset ${bad.chunkStartOffset}`));
+  assert.ok(fs.readFileSync(damaged).equals(bytes));
+  assert.equal(recordingTool("repair", damaged, damaged).code, 1);
+  assert.ok(fs.readFileSync(damaged).equals(bytes));
+
+  const repaired = await openMcap(salvaged);
+  assert.equal(repaired.chunkIndexes.length, FRAMES - 1);
+  const raw = await messagesOn(repaired, "/tof/raw");
+  const original = await messagesOn(reader, "/tof/raw");
+  assert.deepEqual(raw.map((message) => message.sequence),
+                   [original[0].sequence, original[2].sequence]);
+  assert.ok(Buffer.from(raw[1].data).equals(Buffer.from(original[2].data)));
 });
 
 test.after(() => fs.rmSync(dir, { recursive: true, force: true }));
