@@ -109,52 +109,72 @@ std::string format_info(const RecordingInfo& info) {
   return text.str();
 }
 
+namespace {
+
+// repair_recording's copy of `reader`'s complete records into `temporary`.
+RepairResult copy_complete_records(McapReader& reader, const std::filesystem::path& input,
+                                   const std::filesystem::path& temporary,
+                                   const std::function<bool()>& stopped) {
+  RepairResult result;
+  WriterOptions options;
+  options.compression =
+      reader.chunks().empty() ? std::string(kZstd) : reader.chunks().front().compression;
+  options.chunk_size = std::numeric_limits<std::uint64_t>::max();  // as the input's chunks
+  options.library = reader.library();
+  McapWriter writer(temporary, options);
+  for (const AttachmentIndex& index : reader.attachments()) {
+    writer.add_attachment(reader.read_attachment(index));
+  }
+  for (const MetadataIndex& index : reader.metadata()) {
+    writer.add_metadata(reader.read_metadata(index));
+  }
+  std::map<std::uint16_t, std::uint16_t> schema_ids;
+  for (const auto& [id, schema] : reader.schemas()) {
+    schema_ids[id] = writer.add_schema(schema.name, schema.encoding, schema.data);
+  }
+  std::map<std::uint16_t, std::uint16_t> channel_ids;
+  for (const auto& [id, channel] : reader.channels()) {
+    const std::uint16_t schema = channel.schema_id == 0 ? 0 : schema_ids.at(channel.schema_id);
+    channel_ids[id] =
+        writer.add_channel(schema, channel.topic, channel.message_encoding, channel.metadata);
+  }
+  for (const ChunkIndex& chunk : reader.chunks()) {
+    if (stopped()) throw Error("stopped before the repair was complete");
+    for (const Message& message : reader.read_chunk(chunk)) {
+      const auto channel = channel_ids.find(message.channel_id);
+      if (channel == channel_ids.end()) {
+        throw Error(input.string() + ": a message of chunk at offset " +
+                    std::to_string(chunk.chunk_start_offset) + " is on channel " +
+                    std::to_string(message.channel_id) + ", which the file does not define");
+      }
+      writer.write(channel->second, message.sequence, message.log_time, message.publish_time,
+                   message.data);
+      ++result.messages;
+    }
+    writer.close_chunk();
+    ++result.chunks;
+  }
+  writer.finish();
+  if (reader.recovery()) result.lost_bytes = reader.file_size() - reader.recovery()->readable_bytes;
+  return result;
+}
+
+}  // namespace
+
 RepairResult repair_recording(const std::filesystem::path& input,
-                              const std::filesystem::path& output) {
+                              const std::filesystem::path& output,
+                              const std::function<bool()>& stopped) {
   McapReader reader(input);
   const std::filesystem::path temporary = output.string() + ".repairing";
   RepairResult result;
-  {
-    WriterOptions options;
-    options.compression =
-        reader.chunks().empty() ? std::string(kZstd) : reader.chunks().front().compression;
-    options.chunk_size = std::numeric_limits<std::uint64_t>::max();  // as the input's chunks
-    options.library = reader.library();
-    McapWriter writer(temporary, options);
-    for (const AttachmentIndex& index : reader.attachments()) {
-      writer.add_attachment(reader.read_attachment(index));
-    }
-    for (const MetadataIndex& index : reader.metadata()) {
-      writer.add_metadata(reader.read_metadata(index));
-    }
-    std::map<std::uint16_t, std::uint16_t> schema_ids;
-    for (const auto& [id, schema] : reader.schemas()) {
-      schema_ids[id] = writer.add_schema(schema.name, schema.encoding, schema.data);
-    }
-    std::map<std::uint16_t, std::uint16_t> channel_ids;
-    for (const auto& [id, channel] : reader.channels()) {
-      const std::uint16_t schema = channel.schema_id == 0 ? 0 : schema_ids.at(channel.schema_id);
-      channel_ids[id] =
-          writer.add_channel(schema, channel.topic, channel.message_encoding, channel.metadata);
-    }
-    for (const ChunkIndex& chunk : reader.chunks()) {
-      for (const Message& message : reader.read_chunk(chunk)) {
-        const auto channel = channel_ids.find(message.channel_id);
-        if (channel == channel_ids.end()) {
-          throw Error(input.string() + ": a message of chunk at offset " +
-                      std::to_string(chunk.chunk_start_offset) + " is on channel " +
-                      std::to_string(message.channel_id) + ", which the file does not define");
-        }
-        writer.write(channel->second, message.sequence, message.log_time, message.publish_time,
-                     message.data);
-        ++result.messages;
-      }
-      writer.close_chunk();
-      ++result.chunks;
-    }
-    writer.finish();
+  try {
+    result = copy_complete_records(reader, input, temporary, stopped);
+  } catch (const std::exception& error) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw Error("repairing " + input.string() + ": " + error.what() + "; " + output.string() +
+                " is left as it was");
   }
-  if (reader.recovery()) result.lost_bytes = reader.file_size() - reader.recovery()->readable_bytes;
   std::filesystem::rename(temporary, output);
   return result;
 }

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -51,8 +52,11 @@ struct RepairResult {
 
 // Writes `output` (which may be `input`: it is then replaced once complete) with the
 // attachments, metadata, channels and every complete chunk of `input`, chunk by chunk
-// as they were, and a summary.
-RepairResult repair_recording(const std::filesystem::path& input,
-                              const std::filesystem::path& output);
+// as they were, and a summary. Writes OUTPUT.repairing first and renames it; on an error,
+// or when `stopped` returns true (asked between chunks), removes it, leaves `output` as
+// it was and throws tilth::Error.
+RepairResult repair_recording(
+    const std::filesystem::path& input, const std::filesystem::path& output,
+    const std::function<bool()>& stopped = [] { return false; });
 
 }  // namespace tilth::mcap

@@ -47,10 +47,10 @@ class TemporaryFolder {
   fs::path path_;
 };
 
-std::uint64_t run_conversion(const InProcessGraph& graph, const std::string& what) {
-  const RunResult result = graph.run();
+RunResult run_conversion(const InProcessGraph& graph, const std::string& what) {
+  RunResult result = graph.run();
   if (result.failed) throw Error(what + " failed: " + result.failure);
-  return result.metrics.frames_completed;
+  return result;
 }
 
 void connect_recording_ports(InProcessGraph& graph) {
@@ -81,8 +81,8 @@ fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scrat
 
 }  // namespace
 
-std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder,
-                               const ConversionOptions& options) {
+RunResult export_to_folder(const fs::path& mcap_file, const fs::path& folder,
+                           const ConversionOptions& options) {
   check_output_path(folder, options.overwrite);
   const TemporaryFolder scratch;
   fs::path calibration;
@@ -109,8 +109,8 @@ std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder
   return run_conversion(graph, "exporting " + mcap_file.string());
 }
 
-std::uint64_t import_from_folder(const fs::path& folder, const fs::path& mcap_file,
-                                 const ConversionOptions& options) {
+RunResult import_from_folder(const fs::path& folder, const fs::path& mcap_file,
+                             const ConversionOptions& options) {
   check_output_path(mcap_file, options.overwrite);
   const TemporaryFolder scratch;
   InProcessGraph graph("tilth recording import");

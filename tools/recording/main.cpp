@@ -1,6 +1,7 @@
 // `tilth recording` (the tilth-recording program): look into, repair and convert
 // recordings. MCAP files are read with the mcap plugin's format library; conversions run
 // the recording stages in process (conversion.h).
+#include <atomic>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -10,8 +11,10 @@
 #include "command_line.h"
 #include "commands.h"
 #include "conversion.h"
+#include "data_loss_report.h"
 #include "framework/diagnostics.h"
 #include "mcap_recording.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
 
 namespace {
@@ -31,7 +34,14 @@ constexpr const char* kUsage = R"(usage: tilth recording COMMAND ARGS
   import DIR FILE           an image-folder recording to an MCAP recording
         [--compression zstd|lz4|none] [--overwrite]
 
-Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad usage.
+SIGINT or SIGTERM stops export and import cleanly: the frames converted so far are
+written and the output closed (an MCAP file with its summary), exit code 0; it stops a
+repair, which then removes its partial output and leaves FILE as it was (exit code 1).
+A second signal exits at once (code 130).
+
+Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad usage,
+3 when a conversion's writer could not store every frame (a full disk; the output holds
+the frames before it).
 )";
 
 int usage_error(const std::string& message) {
@@ -62,7 +72,12 @@ int repair(const CommandLine& line) {
     return usage_error("repair takes FILE [OUTPUT]");
   }
   const fs::path output = args.size() == 3 ? args[2] : args[1];
-  const auto result = tilth::mcap::repair_recording(args[1], output);
+  std::atomic<bool> stopped{false};
+  const auto result = [&] {
+    const tilth::tools::StopSignalWatcher watcher("tilth recording",
+                                                  [&stopped] { stopped = true; });
+    return tilth::mcap::repair_recording(args[1], output, [&stopped] { return stopped.load(); });
+  }();
   std::cout << output.string() << ": " << result.messages << " messages in " << result.chunks
             << " chunks, with a summary; " << result.lost_bytes
             << " bytes after the last complete record were dropped\n";
@@ -77,21 +92,23 @@ int convert(const CommandLine& line) {
   }
   tilth::tools::ConversionOptions options;
   options.overwrite = line.flag("--overwrite");
-  if (command == "export") {
-    if (line.value("--compression")) return usage_error("--compression is an import option");
-    const auto frames = tilth::tools::export_to_folder(args[1], args[2], options);
-    std::cout << args[2] << ": " << frames << " frames from " << args[1] << "\n";
-  } else {
-    options.compression = line.value("--compression").value_or("");
-    const auto frames = tilth::tools::import_from_folder(args[1], args[2], options);
-    std::cout << args[2] << ": " << frames << " frames from " << args[1] << "\n";
+  if (command == "export" && line.value("--compression")) {
+    return usage_error("--compression is an import option");
   }
-  return kExitOk;
+  options.compression = line.value("--compression").value_or("");
+  const tilth::RunResult result = command == "export"
+                                      ? tilth::tools::export_to_folder(args[1], args[2], options)
+                                      : tilth::tools::import_from_folder(args[1], args[2], options);
+  std::cerr << tilth::tools::data_loss_report("tilth recording", result.data_lost);
+  std::cout << args[2] << ": " << result.metrics.frames_completed << " frames from " << args[1]
+            << (result.stopped ? "; stopped by a signal" : "") << "\n";
+  return result.data_lost.empty() ? kExitOk : kExitDataLost;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  tilth::tools::install_stop_handlers("tilth recording");
   std::optional<CommandLine> parsed;
   try {
     parsed.emplace(argc, argv, 1, std::set<std::string>{"--compression"},

@@ -6,6 +6,6 @@
 
 namespace tilth {
 
-inline constexpr std::uint32_t kAbiVersion = 2;
+inline constexpr std::uint32_t kAbiVersion = 3;
 
 }  // namespace tilth
