@@ -223,7 +223,7 @@ class McapWriterStage final : public Sink {
     report_data_loss_(
         frames_given_ - frames_stored_,
         why + "; recording stopped: " + std::to_string(frames_given_ - frames_stored_) +
-            " frame(s) not stored, the file keeps the " + std::to_string(frames_stored_) +
+            " frame(s) not stored so far, the file keeps the " + std::to_string(frames_stored_) +
             " before (`tilth recording repair` gives it a summary)");
   }
 

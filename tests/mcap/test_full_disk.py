@@ -90,7 +90,8 @@ class FullDisk(unittest.TestCase):
             self.assertRegex(first, "^" + re.escape(recording) + r": cannot write (before|at) "
                              r"offset \d+: File too large; writing stopped, the file keeps its "
                              r"first (\d+) bytes \((\d+) messages\) without a summary; recording "
-                             r"stopped: \d+ frame\(s\) not stored, the file keeps the (\d+) before")
+                             r"stopped: \d+ frame\(s\) not stored so far, the file keeps the "
+                             r"(\d+) before")
             kept_bytes, kept_messages, kept_frames = map(int, re.search(
                 r"first (\d+) bytes \((\d+) messages\).* keeps the (\d+) before", first).groups())
             self.assertEqual(int(lost.group(1)), FRAMES - kept_frames)
