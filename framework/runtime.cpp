@@ -59,6 +59,8 @@ struct Node {
   LatencyHistogram latency;
   std::atomic<std::uint64_t> errors{0};
   std::atomic<std::uint64_t> skipped{0};
+  std::mutex loss_mutex;
+  std::optional<DataLoss> loss;
 
   void add_delivery(BundlePtr bundle) {
     std::lock_guard lock(inbox_mutex);
@@ -143,10 +145,20 @@ class Runtime::Impl {
     finish_stages();
     RunResult result;
     result.metrics = metrics();
+    result.stopped = stop_requested_;
+    for (auto& node : nodes_) {
+      std::lock_guard lock(node->loss_mutex);
+      if (node->loss) result.data_lost.push_back(*node->loss);
+    }
     std::lock_guard lock(failure_mutex_);
     result.failed = failed_;
     result.failure = failure_;
     return result;
+  }
+
+  void request_stop() {
+    stop_requested_ = true;
+    stop();
   }
 
   void stop() {
@@ -181,7 +193,10 @@ class Runtime::Impl {
       auto node = std::make_unique<Node>();
       node->spec = std::move(spec);
       StageContext context{node->spec.name, node->spec.params, Logger(node->spec.name),
-                           [this] { return metrics(); }};
+                           [this] { return metrics(); },
+                           [this, lost = node.get()](std::uint64_t frames, const std::string& why) {
+                             record_loss(*lost, frames, why);
+                           }};
       try {
         node->instance = registry.create(node->type(), context);
       } catch (const Error& failure) {
@@ -427,6 +442,15 @@ class Runtime::Impl {
     failed_ = true;
   }
 
+  void record_loss(Node& node, std::uint64_t frames, const std::string& why) {
+    std::lock_guard lock(node.loss_mutex);
+    if (!node.loss) {
+      node.loss = DataLoss{node.spec.name, node.type(), 0, why};
+      log(LogLevel::kError, "runtime", node.label() + " lost data: " + why + "; the graph runs on");
+    }
+    node.loss->frames += frames;
+  }
+
   void frame_done(const FrameInfo& info) {
     {
       std::lock_guard lock(done_mutex_);
@@ -464,6 +488,7 @@ class Runtime::Impl {
   std::size_t terminal_count_ = 0;
   std::unique_ptr<FrameAdmission> admission_;
   std::atomic<bool> stopping_{false};
+  std::atomic<bool> stop_requested_{false};
 
   mutable std::mutex done_mutex_;
   std::map<std::uint64_t, std::size_t> remaining_;  // terminal nodes still to finish, per frame
@@ -481,7 +506,7 @@ Runtime::Runtime(ValidatedGraph graph, const StageRegistry& registry, RunLimits 
     : impl_(std::make_unique<Impl>(std::move(graph), registry, limits)) {}
 Runtime::~Runtime() = default;
 RunResult Runtime::run() { return impl_->run(); }
-void Runtime::stop() { impl_->stop(); }
+void Runtime::stop() { impl_->request_stop(); }
 PipelineMetrics Runtime::metrics() const { return impl_->metrics(); }
 
 }  // namespace tilth

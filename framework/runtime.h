@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "framework/graph_validator.h"
 #include "framework/stage_registry.h"
@@ -19,10 +20,20 @@ struct RunLimits {
   std::optional<std::uint64_t> max_frames;  // admit at most this many frames
 };
 
+// What one node could not store (StageContext::report_data_loss).
+struct DataLoss {
+  std::string node;
+  std::string type;
+  std::uint64_t frames = 0;  // frames lost
+  std::string first;         // the node's first report: what failed, where
+};
+
 struct RunResult {
   PipelineMetrics metrics;
-  bool failed = false;  // a source failed, or a stage error stopped the graph (on_error: stop)
-  std::string failure;  // the first such failure
+  bool failed = false;   // a source failed, or a stage error stopped the graph (on_error: stop)
+  std::string failure;   // the first such failure
+  bool stopped = false;  // stop() ended the run
+  std::vector<DataLoss> data_lost;  // per node that reported lost data, in graph order
 };
 
 class Runtime {

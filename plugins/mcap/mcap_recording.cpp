@@ -143,7 +143,8 @@ std::string format_info(const RecordingInfo& info) {
 }
 
 RepairResult repair_recording(const std::filesystem::path& input,
-                              const std::filesystem::path& output) {
+                              const std::filesystem::path& output,
+                              const std::function<bool()>& stopped) {
   namespace fs = std::filesystem;
   std::error_code ignored;
   if (fs::weakly_canonical(input) == fs::weakly_canonical(output) ||
@@ -204,6 +205,7 @@ RepairResult repair_recording(const std::filesystem::path& input,
     };
     for (const auto& [id, channel] : reader.channels()) output_channel(id);
     for (const ChunkIndex& chunk : reader.chunks()) {
+      if (stopped()) throw Error("stopped before the repair was complete");
       std::vector<Message> messages;
       try {
         messages = reader.read_chunk(chunk);
@@ -227,9 +229,10 @@ RepairResult repair_recording(const std::filesystem::path& input,
       ++result.chunks;
     }
     writer.finish();
-  } catch (...) {
+  } catch (const std::exception& error) {
     fs::remove(temporary, ignored);
-    throw;
+    throw Error("repairing " + input.string() + ": " + error.what() + "; " + output.string() +
+                " is left as it was");
   }
   fs::rename(temporary, output);
   std::sort(result.dropped.begin(), result.dropped.end(),

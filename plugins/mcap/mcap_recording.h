@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -65,9 +66,12 @@ struct RepairResult {
 // Writes `output` with the attachments, metadata, channels and every intact chunk of
 // `input`, found by scanning its data section (resynchronising after damage; the
 // summary is not trusted), chunk by chunk as they were, and a summary. The output is
-// written beside itself and renamed into place once complete; `output` may not be
-// `input`: the input is never written.
-RepairResult repair_recording(const std::filesystem::path& input,
-                              const std::filesystem::path& output);
+// written beside itself (OUTPUT.repairing) and renamed into place once complete;
+// `output` may not be `input`: the input is never written. On an error, or when
+// `stopped` returns true (asked between chunks), removes the partial output, leaves
+// `output` as it was and throws tilth::Error.
+RepairResult repair_recording(
+    const std::filesystem::path& input, const std::filesystem::path& output,
+    const std::function<bool()>& stopped = [] { return false; });
 
 }  // namespace tilth::mcap

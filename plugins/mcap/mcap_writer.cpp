@@ -4,7 +4,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <utility>
 
 #include "compression.h"
 #include "crc32.h"
@@ -50,20 +53,42 @@ McapWriter::McapWriter(std::filesystem::path file, WriterOptions options)
                 "' is not supported; expected zstd, lz4 or none");
   }
   out_.open(file_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw Error(file_.string() + ": cannot create the file");
+  if (!out_) {
+    throw Error(file_.string() + ": cannot create the file: " + std::strerror(errno));
+  }
   put(magic());
   put(RecordBuilder().string(options_.profile).string(options_.library).record(Opcode::kHeader));
-  out_.flush();
+  flush_file();
 }
 
 void McapWriter::check_open(std::string_view what) const {
+  if (!failure_.empty()) throw Error(failure_);
   if (finished_) throw Error(file_.string() + ": " + std::string(what) + " after finish()");
 }
 
 void McapWriter::put(std::string_view bytes) {
   out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out_) throw Error(file_.string() + ": cannot write at offset " + std::to_string(offset_));
+  if (!out_)
+    fail("cannot write at offset " + std::to_string(offset_) + ": " + std::strerror(errno));
   offset_ += bytes.size();
+}
+
+void McapWriter::flush_file() {
+  out_.flush();
+  if (!out_)
+    fail("cannot write before offset " + std::to_string(offset_) + ": " + std::strerror(errno));
+  complete_size_ = offset_;
+}
+
+void McapWriter::fail(const std::string& what) {
+  failure_ = file_.string() + ": " + what + "; writing stopped, the file keeps its first " +
+             std::to_string(complete_size_) + " bytes (" + std::to_string(messages_written_) +
+             " messages) without a summary";
+  out_.close();
+  std::error_code error;
+  std::filesystem::resize_file(file_, complete_size_, error);
+  if (error) failure_ += " and could not be cut back to them: " + error.message();
+  throw Error(failure_);
 }
 
 std::uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding,
@@ -96,7 +121,7 @@ void McapWriter::add_attachment(const Attachment& attachment) {
                                  attachment.create_time, attachment.data.size(), attachment.name,
                                  attachment.media_type});
   put(record);
-  out_.flush();
+  flush_file();
 }
 
 void McapWriter::add_metadata(const Metadata& metadata) {
@@ -105,7 +130,7 @@ void McapWriter::add_metadata(const Metadata& metadata) {
   const std::string record = encode(metadata);
   metadata_indexes_.push_back({offset_, record.size(), metadata.name});
   put(record);
-  out_.flush();
+  flush_file();
 }
 
 void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time,
@@ -128,6 +153,7 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
   chunk_records_.append(record_prefix(Opcode::kMessage, head.content().size() + data.size()));
   chunk_records_.append(head.content());
   chunk_records_.append(data);
+  ++chunk_messages_;
 
   if (statistics_.message_count == 0) {
     statistics_.message_start_time = log_time;
@@ -151,11 +177,13 @@ std::size_t McapWriter::compressing() const {
 }
 
 void McapWriter::close_chunk() {
+  check_open("close_chunk");
   if (!chunk_records_.empty()) {
     ClosedChunk chunk;
     chunk.start_time = chunk_start_time_;
     chunk.end_time = chunk_end_time_;
     chunk.uncompressed_size = chunk_records_.size();
+    chunk.messages = std::exchange(chunk_messages_, 0);
     chunk.index = std::move(chunk_index_);
     const bool behind = options_.store_when_behind && compressing() >= options_.chunks_in_flight;
     chunk.compression = behind ? "" : options_.compression;
@@ -182,13 +210,15 @@ void McapWriter::close_chunk() {
 }
 
 void McapWriter::flush() {
+  check_open("flush");
   close_chunk();
   while (!closed_.empty()) write_oldest_chunk();
 }
 
 void McapWriter::write_oldest_chunk() {
-  write_chunk(closed_.front());
+  ClosedChunk chunk = std::move(closed_.front());
   closed_.pop_front();
+  write_chunk(std::move(chunk));
 }
 
 McapWriter::~McapWriter() {
@@ -197,8 +227,14 @@ McapWriter::~McapWriter() {
   }
 }
 
-void McapWriter::write_chunk(ClosedChunk& chunk) {
-  const ChunkData data = chunk.data.get();
+void McapWriter::write_chunk(ClosedChunk chunk) {
+  ChunkData data;
+  try {
+    data = chunk.data.get();
+  } catch (const std::exception& error) {
+    fail("compressing the chunk of messages from " + std::to_string(chunk.start_time) +
+         " ns failed: " + error.what());
+  }
   const std::string& compressed = data.bytes;
   RecordBuilder head;
   head.u64(chunk.start_time)
@@ -231,8 +267,8 @@ void McapWriter::write_chunk(ClosedChunk& chunk) {
             .record(Opcode::kMessageIndex));
   }
   index.message_index_length = offset_ - indexes_start;
-  out_.flush();
-  if (!out_) throw Error(file_.string() + ": cannot write at offset " + std::to_string(offset_));
+  flush_file();
+  messages_written_ += chunk.messages;
   chunk_indexes_.push_back(std::move(index));
 }
 
@@ -274,7 +310,7 @@ void McapWriter::finish() {
   tail += magic();
   put(tail);
   out_.close();
-  if (!out_) throw Error(file_.string() + ": cannot write the summary");
+  if (!out_) fail(std::string("cannot write the summary: ") + std::strerror(errno));
   finished_ = true;
 }
 

@@ -4,7 +4,9 @@
 // Closed chunks are compressed (and their CRC computed) on background threads, off the
 // thread that adds messages, and written, in order, as they complete;
 // each is flushed to the file when written, so a process killed mid-write leaves a file
-// that is readable up to its last written chunk.
+// that is readable up to its last written chunk. A write that fails (a full disk) ends
+// the writer: the file is cut back to its last complete record, and every call after
+// it throws the same error.
 #pragma once
 
 #include <cstdint>
@@ -73,20 +75,30 @@ class McapWriter {
   void finish();
 
   std::uint64_t bytes_written() const { return offset_; }
+  // Messages in chunks written to the file (and flushed).
+  std::uint64_t messages_written() const { return messages_written_; }
 
  private:
   // Writes to the file, counting the offset.
   void put(std::string_view bytes);
+  // Flushes the file, which then ends with a complete record.
+  void flush_file();
+  // Ends the writer: closes the file, cuts it back to its last complete record and
+  // throws Error(failure_).
+  [[noreturn]] void fail(const std::string& what);
   void check_open(std::string_view what) const;
   struct ClosedChunk;
-  void write_chunk(ClosedChunk& chunk);
+  void write_chunk(ClosedChunk chunk);
   void write_oldest_chunk();
 
   const std::filesystem::path file_;
   const WriterOptions options_;
   std::ofstream out_;
   std::uint64_t offset_ = 0;
+  std::uint64_t complete_size_ = 0;  // the file's size at its last complete, flushed record
+  std::uint64_t messages_written_ = 0;
   bool finished_ = false;
+  std::string failure_;  // why writing stopped; "" while it goes on
 
   std::vector<Schema> schemas_;
   std::vector<Channel> channels_;
@@ -99,6 +111,7 @@ class McapWriter {
   std::string chunk_records_;
   std::uint64_t chunk_start_time_ = 0;
   std::uint64_t chunk_end_time_ = 0;
+  std::uint64_t chunk_messages_ = 0;
   // Per channel: (log_time, offset in chunk_records_) of each message.
   using MessageOffsets =
       std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>>;
@@ -114,6 +127,7 @@ class McapWriter {
     std::uint64_t start_time = 0;
     std::uint64_t end_time = 0;
     std::uint64_t uncompressed_size = 0;
+    std::uint64_t messages = 0;
     std::string compression;
     MessageOffsets index;
     std::future<ChunkData> data;

@@ -8,11 +8,17 @@
 // Invariant: a frame's messages are never split across chunks (a chunk is closed only
 // between frames), so a file cut off mid-write loses whole frames, never half of one.
 //
+// A write that fails (a full disk) stops the recording, not the graph: the file keeps
+// the chunks written before it, without a summary (`tilth recording repair` adds one),
+// and every frame not stored is reported as lost data.
+//
 // As in a ROS 2 bag, a message's log (and publish) time is when the frame was captured
 // on the host's clock, so Foxglove shows wall-clock dates; each image's own timestamp
 // is its device time.
 #include <chrono>
+#include <deque>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -95,7 +101,9 @@ class McapWriterStage final : public Sink {
         depth_size_(calibration_.depth.width, calibration_.depth.height),
         color_size_(calibration_.color.width, calibration_.color.height),
         writer_(context.params.path("path"), writer_options(context.params)),
-        log_host_time_(context.params.string("log_time") == "host") {
+        log_host_time_(context.params.string("log_time") == "host"),
+        log_(context.log),
+        report_data_loss_(context.report_data_loss) {
     const std::uint64_t created = now_ns();
     writer_.add_attachment({created, created, std::string(kCalibrationAttachment),
                             "application/json", calibration_text_});
@@ -148,6 +156,39 @@ class McapWriterStage final : public Sink {
         log_host_time_ ? host_time(frame.info(), raw_time) : raw_time;
     const std::uint64_t color_log_time = log_host_time_ ? raw_log_time : color_time;
 
+    ++frames_given_;
+    if (!failure_.empty()) {
+      report_data_loss_(
+          1, "frame " + std::to_string(frame_id) +
+                 " not recorded: the recording stopped at an earlier error: " + failure_);
+      return;
+    }
+    try {
+      write_frame(raw, color, truth, sequence, raw_log_time, color_log_time);
+    } catch (const Error& error) {
+      stop_recording(error.what());
+    }
+  }
+
+  void finish() override {
+    if (failure_.empty()) {
+      try {
+        writer_.finish();
+      } catch (const Error& error) {
+        stop_recording(error.what());
+      }
+    }
+    if (!failure_.empty()) {
+      log_.warning(std::to_string(frames_given_ - frames_stored_) + " of " +
+                   std::to_string(frames_given_) + " frame(s) not recorded; " + failure_);
+    }
+  }
+
+ private:
+  void write_frame(const RawTofFrame& raw, const ColorImage& color, const GroundTruth* truth,
+                   std::uint32_t sequence, std::uint64_t raw_log_time,
+                   std::uint64_t color_log_time) {
+    const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
     writer_.write(raw_channel_, sequence, raw_log_time, raw_log_time,
                   encode_raw_image(raw.gray, "mono16", raw.device_timestamp_ns, kTofFrameId));
     writer_.write(color_channel_, sequence, color_log_time, color_log_time,
@@ -162,18 +203,43 @@ class McapWriterStage final : public Sink {
             encode_raw_image(truth->residue_mask, "mono8", raw.device_timestamp_ns, kTofFrameId));
       }
     }
+    messages_given_ += 2 + (truth != nullptr ? 1 : 0) + (has_mask ? 1 : 0);
+    frame_ends_.push_back(messages_given_);
     writer_.close_chunk_if_full();
+    count_stored_frames();
   }
 
-  void finish() override { writer_.finish(); }
+  // Frames whose every message is in a chunk the file holds.
+  void count_stored_frames() {
+    while (!frame_ends_.empty() && frame_ends_.front() <= writer_.messages_written()) {
+      frame_ends_.pop_front();
+      ++frames_stored_;
+    }
+  }
 
- private:
+  void stop_recording(const std::string& why) {
+    failure_ = why;
+    count_stored_frames();
+    report_data_loss_(
+        frames_given_ - frames_stored_,
+        why + "; recording stopped: " + std::to_string(frames_given_ - frames_stored_) +
+            " frame(s) not stored so far, the file keeps the " + std::to_string(frames_stored_) +
+            " before (`tilth recording repair` gives it a summary)");
+  }
+
   const std::string calibration_text_;
   const RigCalibration calibration_;
   const cv::Size depth_size_;
   const cv::Size color_size_;
   McapWriter writer_;
   const bool log_host_time_;
+  const Logger log_;
+  const std::function<void(std::uint64_t, const std::string&)> report_data_loss_;
+  std::uint64_t frames_given_ = 0;
+  std::uint64_t frames_stored_ = 0;
+  std::uint64_t messages_given_ = 0;
+  std::deque<std::uint64_t> frame_ends_;  // messages given by the end of each frame not stored
+  std::string failure_;                   // why recording stopped; "" while it goes on
   std::uint16_t raw_channel_ = 0;
   std::uint16_t color_channel_ = 0;
   std::uint16_t truth_channel_ = 0;

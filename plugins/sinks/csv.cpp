@@ -1,8 +1,11 @@
 // Writes one CSV row per frame: the frame, its capture times, the ground distance with
-// its validity, the cause when invalid, its quality, the latency from capture, and the ground truth
-// when a truth input is connected. Every row is flushed, so a killed process loses at most the row
-// being written. With rotation by size or age, rows go on in numbered files (run.csv, run.1.csv,
-// run.2.csv, ...), each starting with the header (docs/sinks.md).
+// its validity, the cause when invalid, its quality, the latency from capture, and the
+// ground truth when a truth input is connected. Each row is one write(2), so a killed
+// process loses at most the row being written. A row the disk does not take (full) is
+// cut back off the file, reported as lost data, and the rows after it are written when
+// the disk takes them: the file only ever holds whole rows. With rotation by size or
+// age, rows go on in numbered files (run.csv, run.1.csv, run.2.csv, ...), each starting
+// with the header (docs/sinks.md).
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -10,8 +13,12 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "tilth/messages/ground_distance.h"
 #include "tilth/messages/ground_truth.h"
@@ -39,7 +46,9 @@ class Csv final : public Sink {
   explicit Csv(const StageContext& context)
       : path_(context.params.path("path")),
         rotate_bytes_(static_cast<std::uint64_t>(context.params.integer("rotate_bytes"))),
-        rotate_after_(std::chrono::seconds(context.params.integer("rotate_seconds"))) {
+        rotate_after_(std::chrono::seconds(context.params.integer("rotate_seconds"))),
+        log_(context.log),
+        report_data_loss_(context.report_data_loss) {
     if (path_.has_parent_path()) {
       std::error_code error;
       std::filesystem::create_directories(path_.parent_path(), error);
@@ -48,10 +57,13 @@ class Csv final : public Sink {
                     path_.parent_path().string() + ": " + error.message());
       }
     }
-    open();
+    if (!open()) {
+      throw Error(current_.string() + ": " + write_error_ +
+                  " (parameter 'path' must name a file in a writable directory)");
+    }
   }
   ~Csv() override {
-    if (file_ != nullptr) std::fclose(file_);
+    if (file_ >= 0) ::close(file_);
   }
 
   void consume(const Frame& frame) override {
@@ -76,18 +88,23 @@ class Csv final : public Sink {
                static_cast<long long>(distance.soil_pixels), distance.spread_mm,
                distance.confidence, latency_ms) +
         truth + "\n";
-    if (file_ != nullptr && full_before(row)) {
+    if (file_ >= 0 && full_before(row)) {
       ++number_;
       close();  // when this throws, the next row still goes to the next file
     }
-    if (file_ == nullptr) open();
-    write(row);
-    ++rows_in_file_;
+    // A file whose header the disk did not take gets it with its first row.
+    if ((file_ >= 0 || open()) && append(bytes_in_file_ == 0 ? std::string(kHeader) + row : row)) {
+      ++rows_in_file_;
+      if (lost_in_a_row_ > 0) report_resumed();
+    } else {
+      lose(info.frame_id);
+    }
   }
 
   void finish() override {
-    if (file_ != nullptr && std::fflush(file_) != 0) {
-      throw Error(current_.string() + ": flush failed: " + std::strerror(errno));
+    if (lost_in_a_row_ > 0) {
+      log_.warning(current_.string() + ": the last " + std::to_string(lost_in_a_row_) +
+                   " row(s) were not written; " + std::to_string(rows_lost_) + " lost in all");
     }
   }
 
@@ -106,31 +123,66 @@ class Csv final : public Sink {
     return rotate_after_.count() > 0 && Clock::now() - opened_at_ >= rotate_after_;
   }
 
-  void open() {
+  // Opens the next file of the series and writes its header; false with the error in
+  // write_error_. O_APPEND: after a row is cut back off, the next one goes where it began.
+  bool open() {
     current_ = numbered(path_, number_);
-    file_ = std::fopen(current_.c_str(), "w");
-    if (file_ == nullptr) {
-      throw Error(current_.string() + ": cannot open for writing: " + std::strerror(errno) +
-                  " (parameter 'path' must name a file in a writable directory)");
+    file_ = ::open(current_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0666);
+    if (file_ < 0) {
+      write_error_ = std::string("cannot open for writing: ") + std::strerror(errno);
+      return false;
     }
     opened_at_ = Clock::now();
     bytes_in_file_ = 0;
     rows_in_file_ = 0;
-    write(std::string(kHeader));
+    append(std::string(kHeader));
+    return true;
   }
 
   void close() {
-    std::FILE* file = std::exchange(file_, nullptr);
-    if (std::fclose(file) != 0) {
+    if (::close(std::exchange(file_, -1)) != 0) {
       throw Error(current_.string() + ": close failed: " + std::strerror(errno));
     }
   }
 
-  void write(const std::string& text) {
-    if (std::fputs(text.c_str(), file_) < 0 || std::fflush(file_) != 0) {
-      throw Error(current_.string() + ": write failed: " + std::strerror(errno));
+  // Writes `text` whole, or cuts the file back to its last whole line and returns false
+  // with the error in write_error_.
+  bool append(const std::string& text) {
+    std::size_t written = 0;
+    while (written < text.size()) {
+      const ssize_t count = ::write(file_, text.data() + written, text.size() - written);
+      if (count < 0 && errno == EINTR) continue;
+      if (count <= 0) break;
+      written += static_cast<std::size_t>(count);
     }
-    bytes_in_file_ += text.size();
+    if (written == text.size()) {
+      bytes_in_file_ += text.size();
+      return true;
+    }
+    write_error_ = std::strerror(errno);
+    if (written > 0 && ::ftruncate(file_, static_cast<off_t>(bytes_in_file_)) != 0) {
+      write_error_ +=
+          std::string("; cutting the partial row back off failed too: ") + std::strerror(errno);
+    }
+    return false;
+  }
+
+  void lose(std::uint64_t frame_id) {
+    if (lost_in_a_row_++ == 0) first_lost_ = frame_id;
+    last_lost_ = frame_id;
+    ++rows_lost_;
+    report_data_loss_(1, current_.string() + ": " + write_error_ + "; the row of frame " +
+                             std::to_string(frame_id) + " was not written (" +
+                             std::to_string(rows_lost_) +
+                             " row(s) lost so far); rows are written again when the disk takes "
+                             "them");
+  }
+
+  void report_resumed() {
+    log_.warning(current_.string() + ": writing rows again; " + std::to_string(lost_in_a_row_) +
+                 " row(s) lost (frames " + std::to_string(first_lost_) + " to " +
+                 std::to_string(last_lost_) + "), " + std::to_string(rows_lost_) + " in all");
+    lost_in_a_row_ = 0;
   }
 
   const std::filesystem::path path_;
@@ -138,10 +190,17 @@ class Csv final : public Sink {
   const std::chrono::seconds rotate_after_;
   std::uint64_t number_ = 0;
   std::filesystem::path current_;
-  std::FILE* file_ = nullptr;
+  const Logger log_;
+  const std::function<void(std::uint64_t, const std::string&)> report_data_loss_;
+  int file_ = -1;
   Clock::time_point opened_at_;
   std::uint64_t bytes_in_file_ = 0;
   std::uint64_t rows_in_file_ = 0;
+  std::string write_error_;
+  std::uint64_t rows_lost_ = 0;
+  std::uint64_t lost_in_a_row_ = 0;  // since the last row written
+  std::uint64_t first_lost_ = 0;     // frame ids of the first and last of those
+  std::uint64_t last_lost_ = 0;
 };
 
 StageDescriptor describe() {

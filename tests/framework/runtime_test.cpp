@@ -1,5 +1,6 @@
 // The runtime under concurrency: joining by frame, frame order at stateful stages and
-// sinks, bounded frames in flight with both full-pipeline policies, errors, stop.
+// sinks, bounded frames in flight with both full-pipeline policies, errors, stop, data
+// lost by a sink.
 // Run under ThreadSanitizer by the tsan preset.
 #include "framework/runtime.h"
 
@@ -165,6 +166,7 @@ TEST_F(RuntimeTest, StageErrorStopsTheGraphWhenAsked) {
     "runtime": {"on_error": "stop", "max_in_flight": 1}
   })");
   EXPECT_TRUE(result.failed);
+  EXPECT_FALSE(result.stopped);  // not by stop()
   EXPECT_EQ(result.failure,
             "node 'f' (test.fail) failed on frame 0 (sequence 0): bad value 0; stopping "
             "(on_error: stop)");
@@ -195,12 +197,34 @@ TEST_F(RuntimeTest, StopFinishesFramesInFlight) {
   const RunResult result = runtime->run();
   stopper.join();
   EXPECT_FALSE(result.failed);
+  EXPECT_TRUE(result.stopped);
   const auto seen = values("out");
   EXPECT_GE(seen.size(), 20u);
   EXPECT_EQ(seen, range(static_cast<std::int64_t>(seen.size())));  // nothing lost
   EXPECT_EQ(result.metrics.frames_admitted, seen.size());
   EXPECT_EQ(result.metrics.frames_in_flight, 0u);
   EXPECT_TRUE(sink_log("out").finished);
+}
+
+// A sink that reports lost data is counted, per node, with its first report; the graph
+// runs on and the other sinks get every frame.
+TEST_F(RuntimeTest, LostDataIsCountedPerNodeAndTheGraphRunsOn) {
+  const RunResult result = run(R"({
+    "nodes": {"src": {"type": "test.counter", "params": {"count": 20}},
+              "lossy": {"type": "test.lossy", "params": {"every": 3}},
+              "out": {"type": "test.record"}},
+    "edges": [["src.out", "lossy.in"], ["src.out", "out.in"]],
+    "runtime": {"on_error": "stop"}
+  })");
+  EXPECT_FALSE(result.failed);
+  EXPECT_FALSE(result.stopped);
+  ASSERT_EQ(result.data_lost.size(), 1u);
+  EXPECT_EQ(result.data_lost[0].node, "lossy");
+  EXPECT_EQ(result.data_lost[0].type, "test.lossy");
+  EXPECT_EQ(result.data_lost[0].frames, 7u);  // 0, 3, ..., 18
+  EXPECT_EQ(result.data_lost[0].first, "value 0 not stored");
+  EXPECT_EQ(values("out"), range(20));
+  EXPECT_EQ(result.metrics.frames_completed, 20u);
 }
 
 TEST_F(RuntimeTest, FrameLimit) {

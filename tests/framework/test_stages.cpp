@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -146,6 +147,23 @@ class Record final : public Sink {
   const std::int64_t delay_us_;
 };
 
+// Reports every `every`-th frame (by value) as lost data, as a writer on a full disk does.
+class Lossy final : public Sink {
+ public:
+  explicit Lossy(const StageContext& c)
+      : every_(c.params.integer("every")), report_data_loss_(c.report_data_loss) {}
+  void consume(const Frame& frame) override {
+    const std::int64_t value = frame.input<Count>(0).value;
+    if (value % every_ == 0) {
+      report_data_loss_(1, "value " + std::to_string(value) + " not stored");
+    }
+  }
+
+ private:
+  const std::int64_t every_;
+  const std::function<void(std::uint64_t, const std::string&)> report_data_loss_;
+};
+
 StageDescriptor describe(std::string type, std::vector<PortSpec> inputs,
                          std::vector<PortSpec> outputs, std::vector<ParamSpec> params,
                          Concurrency concurrency, StageFactory create) {
@@ -212,6 +230,10 @@ void register_test_stages(StageRegistry& registry) {
                          ParamSpec::choice("mode", {"fast", "exact"}, "fast").describe("mode"),
                          ParamSpec::path("file", "record.txt").describe("where to write")},
                         Concurrency::kSerial, factory<Record>()),
+               "test_stages");
+  registry.add(describe("test.lossy", {count("in")}, {},
+                        {ParamSpec::integer("every", 5).range(1, std::nullopt).describe("period")},
+                        Concurrency::kSerial, factory<Lossy>()),
                "test_stages");
   registry.add(describe("test.needs_path", {count("in")}, {},
                         {ParamSpec::path("file", std::nullopt).describe("where to write")},

@@ -13,6 +13,7 @@
 #include "mcap_reader.h"
 #include "mcap_recording.h"
 #include "mcap_writer.h"
+#include "tilth/error.h"
 
 namespace tilth::testing {
 namespace {
@@ -305,6 +306,26 @@ TEST_F(McapRecoveryTest, InfoChecksTheDataSectionCrc) {
                                   std::to_string(data_end->offset)),
             std::string::npos)
       << info.problems[0];
+}
+
+// A stop signal during `tilth recording repair FILE`: FILE is left as it was, and no
+// partial output remains.
+TEST_F(McapRecoveryTest, StoppedRepairLeavesTheFileAsItWas) {
+  const fs::path file = dir_.path() / "cut.mcap";
+  copy_prefix(complete_, file, chunks_[3].chunk_start_offset + 100);
+  const std::string before = read_text(file);
+  int asked = 0;
+  try {
+    mcap::repair_recording(file, file, [&asked] { return ++asked == 2; });
+    FAIL() << "a stopped repair returned";
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()), "repairing " + file.string() +
+                                             ": stopped before the repair was complete; " +
+                                             file.string() + " is left as it was");
+  }
+  EXPECT_EQ(asked, 2);  // once per chunk, until it said stop
+  EXPECT_EQ(read_text(file), before);
+  EXPECT_FALSE(fs::exists(file.string() + ".repairing"));
 }
 
 TEST_F(McapRecoveryTest, CorruptChunkIsReportedWithItsOffset) {

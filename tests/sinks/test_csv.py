@@ -1,9 +1,12 @@
 """sinks.csv in `tilth run`s of a known distance sequence (testdistance.sequence): the
 header and one exact row per frame, rotation into numbered files by size and by age,
-nothing but the last line damaged by a SIGKILL, and the error for an unwritable path."""
+nothing but the last line damaged by a SIGKILL, the error for an unwritable path, and a
+full disk (a file size limit, RLIMIT_FSIZE): whole rows only, the rows lost counted and
+reported, exit code 3, and the rest of the graph running on."""
 import json
 import os
 import re
+import resource
 import signal
 import subprocess
 import tempfile
@@ -156,6 +159,100 @@ class KillSafety(unittest.TestCase):
         if last:  # cut mid-row: the start of the next frame's row
             self.assertLessEqual(len(last.split(",")), len(FIELDS))
             self.assertTrue(str(len(complete)).startswith(last.split(",")[0]), last)
+
+
+def limit_file_size(limit):
+    """In the child: files stop growing at `limit` bytes, with EFBIG as on a full disk."""
+    def apply():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return apply
+
+
+def run_limited(directory, nodes, edges, limit, *options):
+    graph = os.path.join(directory, "graph.json")
+    with open(graph, "w") as f:
+        json.dump({"nodes": nodes, "edges": edges}, f)
+    return subprocess.run(tilth_command(graph) + list(options), capture_output=True, text=True,
+                          timeout=60, env=tilth_env(), preexec_fn=limit_file_size(limit))
+
+
+def whole_rows(test, path):
+    """A file's rows, after checking every line has every column."""
+    rows = rows_of(path)
+    for row in rows:
+        test.assertEqual(len(row), len(FIELDS), row)
+        test.assertNotIn(None, row.values(), row)
+        float(row["distance_mm"]), float(row["latency_ms"])  # noqa: B018 (parses)
+    with open(path) as f:
+        test.assertTrue(all(len(line.split(",")) == len(FIELDS) for line in f), path)
+    return rows
+
+
+def lost_frames(test, stderr, node):
+    match = re.search(r"^tilth run: data lost: node '%s' \(sinks\.csv\): (\d+) frame\(s\) not "
+                      r"stored; first report: (.*)$" % node, stderr, re.M)
+    test.assertIsNotNone(match, stderr)
+    return int(match.group(1)), match.group(2)
+
+
+class FullDisk(unittest.TestCase):
+    LIMIT = 8000
+
+    def test_rows_that_do_not_fit_are_lost_whole_and_the_graph_runs_on(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            full = os.path.join(tmp, "full.csv")
+            other_dir = os.path.join(tmp, "other")
+            nodes = {"source": {"type": "testdistance.sequence",
+                                "params": {"frames": 400, "fps": 0}},
+                     "full": {"type": "sinks.csv", "params": {"path": full}},
+                     "other": {"type": "sinks.csv",
+                               "params": {"path": os.path.join(other_dir, "run.csv"),
+                                          "rotate_bytes": 2000}}}
+            edges = [["source.distance", "full.distance"], ["source.distance", "other.distance"]]
+            result = run_limited(tmp, nodes, edges, self.LIMIT)
+            self.assertEqual(result.returncode, 3, result.stderr)
+            rows = whole_rows(self, full)
+            self.assertLessEqual(os.path.getsize(full), self.LIMIT)
+            self.assertGreater(len(rows), 40)
+            self.assertEqual([row["index"] for row in rows], [str(i) for i in range(len(rows))])
+            lost, first = lost_frames(self, result.stderr, "full")
+            self.assertEqual(lost, 400 - len(rows))
+            self.assertEqual(first, "%s: File too large; the row of frame %d was not written "
+                             "(1 row(s) lost so far); rows are written again when the disk "
+                             "takes them" % (full, len(rows)))
+            self.assertIn("error: runtime: node 'full' (sinks.csv) lost data: " + first +
+                          "; the graph runs on", result.stderr)
+            # The other sink got every frame, before the full disk and after it.
+            other = [row for path in rotated_files(other_dir) for row in whole_rows(self, path)]
+            self.assertEqual([row["index"] for row in other], [str(i) for i in range(400)])
+
+    def test_rows_are_written_again_when_the_disk_takes_them(self):
+        """A new file each second: each fills up, then loses rows until the next."""
+        with tempfile.TemporaryDirectory() as tmp:
+            nodes = {"source": {"type": "testdistance.sequence",
+                                "params": {"frames": 750, "fps": 300}},
+                     "csv": {"type": "sinks.csv",
+                             "params": {"path": os.path.join(tmp, "run.csv"),
+                                        "rotate_seconds": 1}}}
+            result = run_limited(tmp, nodes, [["source.distance", "csv.distance"]], 3000)
+            self.assertEqual(result.returncode, 3, result.stderr)
+            files = rotated_files(tmp)
+            rows = [whole_rows(self, path) for path in files]
+        self.assertGreaterEqual(len(files), 2)
+        for part in rows:
+            self.assertGreater(len(part), 20)
+            indices = [int(row["index"]) for row in part]
+            self.assertEqual(indices, list(range(indices[0], indices[0] + len(part))))
+        written = sum(len(part) for part in rows)
+        lost, _ = lost_frames(self, result.stderr, "csv")
+        self.assertEqual(lost + written, 750)
+        resumed = re.findall(r"warning: csv: (\S+): writing rows again; (\d+) row\(s\) lost "
+                             r"\(frames (\d+) to (\d+)\)", result.stderr)
+        self.assertEqual(len(resumed), len(files) - 1, result.stderr)
+        for (path, count, first, last), part in zip(resumed, rows[1:]):
+            self.assertEqual(int(last) + 1, int(part[0]["index"]))
+            self.assertEqual(int(count), int(last) - int(first) + 1)
 
 
 class Errors(unittest.TestCase):

@@ -59,8 +59,14 @@ void JobPool::run_one(std::size_t index, PreparedJob job, JobRun& result) {
     progress_.frames_done += run.metrics.frames_completed;
   }
   runtime.reset();  // the sinks close their files
-  result.failed = run.failed;
-  result.failure = run.failure;
+  // A graph whose sinks lost data has no complete results to compare.
+  result.failed = run.failed || !run.data_lost.empty();
+  if (run.failed) {
+    result.failure = run.failure;
+  } else if (!run.data_lost.empty()) {
+    const DataLoss& loss = run.data_lost.front();
+    result.failure = "node '" + loss.node + "' (" + loss.type + ") lost data: " + loss.first;
+  }
   result.metrics = std::move(run.metrics);
 }
 

@@ -206,7 +206,7 @@ int run(Options options) {
 
 int main(int argc, char** argv) {
   using namespace tilth::ab;
-  tilth::tools::block_stop_signals();  // before any thread exists
+  tilth::tools::install_stop_handlers("ab");
   Options options;
   try {
     options = parse_options(argc, argv);

@@ -19,6 +19,8 @@ variant and recording, several at once, as fast as they go) and compares the var
 with the recordings' ground truth: distance error, missed and false-valid frames, mask
 IoU / precision / recall, time per stage. Writes DIR/report.html (self-contained),
 summary.json, summary.csv and frames.csv. docs/ab-testing.md explains every figure.
+SIGINT or SIGTERM stops the graphs cleanly and writes no report (exit code 1); a second
+signal exits at once (code 130).
 
   RECORDING                 an image-folder recording (a folder with recording.json),
                             an .mcap file, or a folder holding several of them

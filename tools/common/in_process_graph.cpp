@@ -4,6 +4,7 @@
 
 #include "framework/graph_session.h"
 #include "framework/graph_validator.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 
@@ -55,6 +56,7 @@ void InProcessGraph::add_edge(const std::string& from, const std::string& to) {
 RunResult InProcessGraph::run() const {
   const auto registry = load_plugins({});
   Runtime runtime(validate_graph(spec_, *registry), *registry);
+  const StopSignalWatcher watcher(program_, [&runtime] { runtime.stop(); });
   return runtime.run();
 }
 

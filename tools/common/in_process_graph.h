@@ -29,7 +29,9 @@ class InProcessGraph {
   void set_runtime(RuntimeOptions options) { spec_.runtime = options; }
 
   // Loads the plugins, validates (throws GraphError with every problem), makes the stages
-  // (throws tilth::Error naming each that failed to start) and runs until the sources end.
+  // (throws tilth::Error naming each that failed to start) and runs until the sources end
+  // or a stop signal stops it as it stops `tilth run` (RunResult::stopped; the program
+  // calls install_stop_handlers first).
   RunResult run() const;
 
  private:

@@ -1,23 +1,25 @@
-// Stopping a tool that runs graphs on SIGINT / SIGTERM: the first signal asks it to stop
-// (frames in flight finish), a second exits at once.
+// Stopping a tool on SIGINT / SIGTERM: the first signal asks it to stop (frames in flight
+// finish, files are closed), a second exits at once with code 130. The handlers only
+// write the signal to a pipe that StopSignalWatcher's thread reads, so whichever thread
+// the kernel delivers a signal to (a library's own thread included), it becomes a clean
+// stop.
 #pragma once
 
-#include <atomic>
 #include <functional>
 #include <string>
 #include <thread>
 
 namespace tilth::tools {
 
-// Blocks the stop signals in the calling thread. Call it before any thread starts: every
-// thread inherits the mask, so only StopSignalWatcher's receives them.
-void block_stop_signals();
+// Installs the handlers for the whole process; call it first thing in main(). `tool`
+// names the message of the second signal. A stop signal that arrives while no watcher
+// runs waits for the next one.
+void install_stop_handlers(const std::string& tool);
 
-// Waits for the stop signals on its own thread while it lives.
+// Calls `stop` on its own thread at the first stop signal, while it lives.
 class StopSignalWatcher {
  public:
-  // `tool` names the log lines; `stop` is called on the watcher's thread at the first
-  // signal.
+  // `tool` names the log line.
   StopSignalWatcher(std::string tool, std::function<void()> stop);
   ~StopSignalWatcher();
   StopSignalWatcher(const StopSignalWatcher&) = delete;
@@ -28,7 +30,6 @@ class StopSignalWatcher {
 
   const std::string tool_;
   const std::function<void()> stop_;
-  std::atomic<bool> done_{false};
   std::thread thread_;
 };
 

@@ -48,10 +48,10 @@ class TemporaryFolder {
   fs::path path_;
 };
 
-std::uint64_t run_conversion(const InProcessGraph& graph, const std::string& what) {
-  const RunResult result = graph.run();
+RunResult run_conversion(const InProcessGraph& graph, const std::string& what) {
+  RunResult result = graph.run();
   if (result.failed) throw Error(what + " failed: " + result.failure);
-  return result.metrics.frames_completed;
+  return result;
 }
 
 void connect_recording_ports(InProcessGraph& graph) {
@@ -81,8 +81,8 @@ fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scrat
 
 }  // namespace
 
-std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder,
-                               const ConversionOptions& options) {
+RunResult export_to_folder(const fs::path& mcap_file, const fs::path& folder,
+                           const ConversionOptions& options) {
   check_apart(mcap_file, folder);
   check_output_path(folder, RecordingKind::kImageFolder, options.overwrite);
   const TemporaryFolder scratch;
@@ -110,8 +110,8 @@ std::uint64_t export_to_folder(const fs::path& mcap_file, const fs::path& folder
   return run_conversion(graph, "exporting " + mcap_file.string());
 }
 
-std::uint64_t import_from_folder(const fs::path& folder, const fs::path& mcap_file,
-                                 const ConversionOptions& options) {
+RunResult import_from_folder(const fs::path& folder, const fs::path& mcap_file,
+                             const ConversionOptions& options) {
   check_apart(folder, mcap_file);
   check_output_path(mcap_file, RecordingKind::kMcapFile, options.overwrite);
   const TemporaryFolder scratch;

@@ -5,9 +5,10 @@
 // carry through as every other field does.
 #pragma once
 
-#include <cstdint>
 #include <filesystem>
 #include <string>
+
+#include "framework/runtime.h"
 
 namespace tilth::tools {
 
@@ -17,16 +18,16 @@ struct ConversionOptions {
 };
 
 // mcap.player -> recording.image_folder_writer, with the calibration the MCAP file
-// carries. Returns the frames written; throws tilth::Error (or GraphError) saying what
-// and where.
-std::uint64_t export_to_folder(const std::filesystem::path& mcap_file,
-                               const std::filesystem::path& folder,
-                               const ConversionOptions& options);
+// carries. Returns the run (frames written: metrics.frames_completed; a stop signal ends
+// it early with a complete output); throws tilth::Error (or GraphError) saying what and
+// where.
+RunResult export_to_folder(const std::filesystem::path& mcap_file,
+                           const std::filesystem::path& folder, const ConversionOptions& options);
 
 // recording.image_folder -> mcap.writer, with the calibration recording.json names
 // (a file, or an inline object).
-std::uint64_t import_from_folder(const std::filesystem::path& folder,
-                                 const std::filesystem::path& mcap_file,
-                                 const ConversionOptions& options);
+RunResult import_from_folder(const std::filesystem::path& folder,
+                             const std::filesystem::path& mcap_file,
+                             const ConversionOptions& options);
 
 }  // namespace tilth::tools

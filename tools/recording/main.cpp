@@ -1,6 +1,7 @@
 // `tilth recording` (the tilth-recording program): look into, repair and convert
 // recordings. MCAP files are read with the mcap plugin's format library; conversions run
 // the recording stages in process (conversion.h).
+#include <atomic>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -10,9 +11,11 @@
 #include "command_line.h"
 #include "commands.h"
 #include "conversion.h"
+#include "data_loss_report.h"
 #include "framework/diagnostics.h"
 #include "mcap_recording.h"
 #include "output_path.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
 
 namespace {
@@ -36,8 +39,15 @@ constexpr const char* kUsage = R"(usage: tilth recording COMMAND ARGS
 --overwrite replaces only a recording (an MCAP file, a folder with recording.json),
 and no output may be, hold or lie inside its input.
 
+SIGINT or SIGTERM stops export and import cleanly: the frames converted so far are
+written and the output closed (an MCAP file with its summary), exit code 0; it stops a
+repair, which then removes its partial output and leaves FILE as it was (exit code 1).
+A second signal exits at once (code 130).
+
 Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad
-usage, 3 when info finds damage or repair had to leave data out (both say what).
+usage, 3 when info finds damage, repair had to leave data out (both say what), or a
+conversion's writer could not store every frame (a full disk; the output holds the
+frames before it).
 )";
 
 constexpr int kExitDamaged = 3;
@@ -71,12 +81,18 @@ int repair(const CommandLine& line) {
   if (args.size() != 3 || line.value("--compression")) {
     return usage_error("repair takes FILE OUTPUT [--overwrite]");
   }
-  const fs::path input = args[1];
-  const fs::path output = args[2];
-  tilth::tools::check_apart(input, output);
-  tilth::tools::check_output_path(output, tilth::tools::RecordingKind::kMcapFile,
-                                  line.flag("--overwrite"));
-  const auto result = tilth::mcap::repair_recording(input, output);
+--overwrite replaces only a recording (an MCAP file, a folder with recording.json),
+and no output may be, hold or lie inside its input.
+
+SIGINT or SIGTERM stops export and import cleanly: the frames converted so far are
+written and the output closed (an MCAP file with its summary), exit code 0; it stops a
+repair, which then removes its partial output and leaves FILE as it was (exit code 1).
+A second signal exits at once (code 130).
+
+Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad
+usage, 3 when info finds damage, repair had to leave data out (both say what), or a
+conversion's writer could not store every frame (a full disk; the output holds the
+frames before it).
   std::cout << output.string() << ": " << result.messages << " messages in " << result.chunks
             << " chunks, with a summary\n";
   if (result.dropped.empty()) return kExitOk;
@@ -99,21 +115,23 @@ int convert(const CommandLine& line) {
   }
   tilth::tools::ConversionOptions options;
   options.overwrite = line.flag("--overwrite");
-  if (command == "export") {
-    if (line.value("--compression")) return usage_error("--compression is an import option");
-    const auto frames = tilth::tools::export_to_folder(args[1], args[2], options);
-    std::cout << args[2] << ": " << frames << " frames from " << args[1] << "\n";
-  } else {
-    options.compression = line.value("--compression").value_or("");
-    const auto frames = tilth::tools::import_from_folder(args[1], args[2], options);
-    std::cout << args[2] << ": " << frames << " frames from " << args[1] << "\n";
+  if (command == "export" && line.value("--compression")) {
+    return usage_error("--compression is an import option");
   }
-  return kExitOk;
+  options.compression = line.value("--compression").value_or("");
+  const tilth::RunResult result = command == "export"
+                                      ? tilth::tools::export_to_folder(args[1], args[2], options)
+                                      : tilth::tools::import_from_folder(args[1], args[2], options);
+  std::cerr << tilth::tools::data_loss_report("tilth recording", result.data_lost);
+  std::cout << args[2] << ": " << result.metrics.frames_completed << " frames from " << args[1]
+            << (result.stopped ? "; stopped by a signal" : "") << "\n";
+  return result.data_lost.empty() ? kExitOk : kExitDataLost;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  tilth::tools::install_stop_handlers("tilth recording");
   std::optional<CommandLine> parsed;
   try {
     parsed.emplace(argc, argv, 1, std::set<std::string>{"--compression"},

@@ -9,9 +9,11 @@
 
 #include "command_line.h"
 #include "commands.h"
+#include "data_loss_report.h"
 #include "framework/diagnostics.h"
 #include "in_process_graph.h"
 #include "output_path.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 
@@ -41,6 +43,11 @@ an image-folder recording.
   --format mcap|folder   the output format, whatever OUTPUT's extension
   --compression C        MCAP chunk compression: zstd (default), lz4 or none
   --overwrite            replace an existing OUTPUT
+
+SIGINT or SIGTERM stops it cleanly: the frames rendered so far are written and the
+recording closed (an MCAP file with its summary), exit code 0; a second signal exits at
+once (code 130). Exit code 1 when it fails, 2 for bad usage, 3 when the writer could not
+store every frame (a full disk; the recording holds the frames before it).
 )";
 
 int usage_error(const std::string& message) {
@@ -69,6 +76,7 @@ std::string command_text(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  tilth::tools::install_stop_handlers("tilth simulate");
   std::optional<CommandLine> parsed;
   try {
     parsed.emplace(argc, argv, 1,
@@ -140,12 +148,14 @@ int main(int argc, char** argv) {
              : tilth::RuntimeOptions{4, tilth::FullPolicy::kBlock, tilth::ErrorPolicy::kStop});
 
     const tilth::RunResult result = graph.run();
+    std::cerr << tilth::tools::data_loss_report("tilth simulate", result.data_lost);
     if (result.failed) throw tilth::Error(result.failure);
     std::cout << output.string() << ": " << result.metrics.frames_completed << " frames (" << format
               << ")";
     if (live) std::cout << ", " << result.metrics.frames_dropped << " dropped";
+    if (result.stopped) std::cout << "; stopped by a signal";
     std::cout << "\n";
-    return kExitOk;
+    return result.data_lost.empty() ? kExitOk : kExitDataLost;
   } catch (const tilth::GraphError& error) {
     std::cerr << error.what() << "\n";
     return kExitUsage;

@@ -1,5 +1,5 @@
 // The `tilth` subcommands. Each returns the process exit code: 0 success, 1 the run
-// failed, 2 bad usage or an invalid graph.
+// failed, 2 bad usage or an invalid graph, 3 the run ended but a stage lost data.
 #pragma once
 
 namespace tilth::cli {
@@ -13,5 +13,6 @@ int dot_command(int argc, char** argv);
 constexpr int kExitOk = 0;
 constexpr int kExitFailed = 1;
 constexpr int kExitUsage = 2;
+constexpr int kExitDataLost = 3;
 
 }  // namespace tilth::cli

@@ -1,11 +1,13 @@
 // `tilth run`: runs a graph until its sources end, --frames is reached, or SIGINT /
-// SIGTERM asks it to stop (frames in flight finish, sinks flush, exit code 0).
+// SIGTERM asks it to stop (frames in flight finish, sinks flush, exit code 0; 3 when a
+// stage lost data).
 #include <iostream>
 
 #include <unistd.h>
 
 #include "command_line.h"
 #include "commands.h"
+#include "data_loss_report.h"
 #include "framework/diagnostics.h"
 #include "framework/graph_session.h"
 #include "framework/runtime.h"
@@ -22,8 +24,10 @@ const std::string kUsage =
         "usage: tilth run GRAPH [--set NODE.PARAM=VALUE]... [--var NAME=VALUE]... [--frames N]\n"
         "                 [--quiet] [--verbose]\n\n"
         "Runs a graph. Ctrl-C (SIGINT) or SIGTERM stops it cleanly: frames in flight\n"
-        "finish and sinks flush; a second Ctrl-C exits at once. At the end each stage's\n"
-        "latency and the graph's frame rate are printed.\n\n") +
+        "finish and sinks flush; a second signal exits at once (code 130). At the end each\n"
+        "stage's latency and the graph's frame rate are printed.\n\n"
+        "Exit code 0 success, 1 the run failed, 2 bad usage or an invalid graph, 3 the run\n"
+        "ended but a stage could not store data (a full disk; each such stage is named).\n\n") +
     kGraphOptionsHelp +
     "  --frames N              stop after N frames\n"
     "  --quiet                 no status line and no summary\n"
@@ -35,7 +39,7 @@ constexpr std::uint64_t kMaxFrames = 1'000'000'000'000;
 }  // namespace
 
 int run_command(int argc, char** argv) {
-  tools::block_stop_signals();  // before any thread exists
+  tools::install_stop_handlers("run");
 
   const CommandLine line(argc, argv, 2, {"--set", "--var", "--frames"},
                          {"--help", "--quiet", "--verbose"});
@@ -77,11 +81,12 @@ int run_command(int argc, char** argv) {
     result = runtime->run();
   }
   if (!line.flag("--quiet")) std::cerr << metrics_report(result.metrics);
+  std::cerr << tools::data_loss_report("tilth run", result.data_lost);
   if (result.failed) {
     std::cerr << "tilth run: " << result.failure << "\n";
     return kExitFailed;
   }
-  return kExitOk;
+  return result.data_lost.empty() ? kExitOk : kExitDataLost;
 }
 
 }  // namespace tilth::cli

@@ -1,7 +1,8 @@
-// What a stage is constructed with: its node name, checked parameters, a logger, and
-// access to the running pipeline's metrics.
+// What a stage is constructed with: its node name, checked parameters, a logger, access
+// to the running pipeline's metrics, and where to report data it could not store.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -16,6 +17,12 @@ struct StageContext {
   Params params;
   Logger log{""};
   std::function<PipelineMetrics()> pipeline_metrics;
+  // A stage that could not store what it was given (a full disk) reports it here and
+  // goes on: the frames this report loses, and why (the file, the error, what is lost so
+  // far). The runtime logs a node's first report, counts the frames, and the run ends
+  // with data lost (docs/runtime.md, "Lost data"). Thread-safe.
+  std::function<void(std::uint64_t frames, const std::string& why)> report_data_loss =
+      [](std::uint64_t, const std::string&) {};
 };
 
 }  // namespace tilth
