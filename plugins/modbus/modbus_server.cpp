@@ -114,7 +114,8 @@ class ModbusServer::Connections {
         log_(std::move(log)),
         started_(Clock::now()),
         comings_and_goings_(log_, LogLevel::kInfo, kLogPeriod),
-        refusals_(log_, LogLevel::kWarning, kLogPeriod),
+        refused_outsiders_(log_, LogLevel::kWarning, kLogPeriod),
+        refused_when_full_(log_, LogLevel::kWarning, kLogPeriod),
         idle_closes_(log_, LogLevel::kInfo, kLogPeriod),
         protocol_errors_(log_, LogLevel::kWarning, kLogPeriod) {
     const std::string where = options.address + ":" + std::to_string(options.port);
@@ -199,8 +200,9 @@ class ModbusServer::Connections {
     return text;
   }
 
-  std::array<LogThrottle*, 4> throttles() {
-    return {&comings_and_goings_, &refusals_, &idle_closes_, &protocol_errors_};
+  std::array<LogThrottle*, 5> throttles() {
+    return {&comings_and_goings_, &refused_outsiders_, &refused_when_full_, &idle_closes_,
+            &protocol_errors_};
   }
 
   bool idle_timeout_applies(const Connection& connection) const {
@@ -257,18 +259,20 @@ class ModbusServer::Connections {
 
   // Keeps `connection`, or closes it at once with the reason logged.
   void admit(Connection connection, std::uint32_t address, Clock::time_point now) {
-    const auto plc_connections = static_cast<int>(std::count_if(
-        connections_.begin(), connections_.end(), [](const Connection& c) { return c.plc; }));
-    const auto other_connections = static_cast<int>(connections_.size()) - plc_connections;
+    if (!connection.plc && !options_.allow.empty() && !options_.allow.contains(address)) {
+      return refuse(connection, refused_outsiders_, now,
+                    "not in 'allow' (" + options_.allow.text() + ")");
+    }
+    const int slots = connection.plc ? options_.plc_clients : options_.max_clients;
+    // A client that reconnects at once must find the slot of its old connection free,
+    // also when that connection's end arrived after poll() returned.
+    if (taken(connection.plc) >= slots) serve_ready_connections();
     if (connection.plc) {
-      if (plc_connections >= options_.plc_clients) make_room_for_plc(connection, now);
+      if (taken(true) >= slots) make_room_for_plc(connection, now);
       keep_alive(connection.fd);
-    } else if (!options_.allow.empty() && !options_.allow.contains(address)) {
-      return refuse(connection, now, "not in 'allow' (" + options_.allow.text() + ")");
-    } else if (other_connections >= options_.max_clients) {
-      return refuse(
-          connection, now,
-          "max_clients (" + std::to_string(options_.max_clients) + ") other clients are connected");
+    } else if (taken(false) >= slots) {
+      return refuse(connection, refused_when_full_, now,
+                    "max_clients (" + std::to_string(slots) + ") other clients are connected");
     }
     const int on = 1;
     setsockopt(connection.fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);  // one packet each
@@ -279,6 +283,23 @@ class ModbusServer::Connections {
       comings_and_goings_.event(now, what);
     }
     connections_.push_back(std::move(connection));
+  }
+
+  // The PLC's connections, or the other clients'.
+  int taken(bool plc) const {
+    return static_cast<int>(std::count_if(connections_.begin(), connections_.end(),
+                                          [plc](const Connection& c) { return c.plc == plc; }));
+  }
+
+  // Reads and answers what has arrived on any connection by now, without waiting.
+  void serve_ready_connections() {
+    std::vector<pollfd> polled;
+    for (const auto& connection : connections_) polled.push_back({connection.fd, POLLIN, 0});
+    if (::poll(polled.data(), polled.size(), 0) <= 0) return;
+    for (std::size_t i = 0; i < connections_.size(); ++i) {
+      if (polled[i].revents != 0) receive(connections_[i]);
+    }
+    std::erase_if(connections_, [](const Connection& c) { return c.fd == -1; });
   }
 
   // A PLC that lost its link reconnects while its old connection still looks open: the
@@ -298,9 +319,10 @@ class ModbusServer::Connections {
     connections_.erase(quietest);
   }
 
-  void refuse(Connection& connection, Clock::time_point now, const std::string& why) {
+  void refuse(Connection& connection, LogThrottle& throttle, Clock::time_point now,
+              const std::string& why) {
     ::close(connection.fd);
-    refusals_.event(now, "refused the connection from " + connection.peer + ": " + why);
+    throttle.event(now, "refused the connection from " + connection.peer + ": " + why);
   }
 
   // Reads what the socket has and answers every whole frame; closes the connection on
@@ -429,7 +451,8 @@ class ModbusServer::Connections {
   int listen_fd_ = -1;
   std::vector<Connection> connections_;
   LogThrottle comings_and_goings_;
-  LogThrottle refusals_;
+  LogThrottle refused_outsiders_;
+  LogThrottle refused_when_full_;
   LogThrottle idle_closes_;
   LogThrottle protocol_errors_;
 };

@@ -139,7 +139,7 @@ StageDescriptor describe() {
           .range(1, 256)
           .describe("server: other clients served at once; more are refused"),
       ParamSpec::integer("idle_timeout_ms", 5000)
-          .range(0, 3600000)
+          .range(0, 600000)
           .in_unit("ms")
           .describe("server: other clients without a request for this long are closed; 0 = never"),
   };

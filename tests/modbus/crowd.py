@@ -1,8 +1,8 @@
 """A crowd of other Modbus TCP clients for the connection-policy test, in a process of its
 own so that its threads do not slow down the test's PLC: for SECONDS it runs
 
-- 50 pollers from 127.0.0.1, each reading the block every 20 ms and reconnecting 50 ms
-  after its connection is refused or closed;
+- 50 pollers from 127.0.0.1, each reading the block every 20 ms, 10 times a connection,
+  and reconnecting 50 ms after its connection ends, is refused or closed;
 - bursts of 50 idle connections from 127.0.0.1, a new burst every 1.5 s;
 - connections that send bytes that are not Modbus TCP, or half a request and then one
   byte every 0.2 s (slowloris);
@@ -21,6 +21,7 @@ import threading
 import time
 
 POLLERS = 50
+READS_PER_CONNECTION = 10
 BURST = 50
 BURST_PERIOD_S = 1.5
 READ = struct.pack(">HHHBBHH", 1, 0, 6, 1, 3, 0, 11)
@@ -51,7 +52,7 @@ def poller(port, deadline, counts):
     while time.monotonic() < deadline:
         try:
             with connect(port) as connection:
-                while time.monotonic() < deadline:
+                for _ in range(READS_PER_CONNECTION):
                     connection.sendall(READ)
                     answer = connection.recv(64)
                     if not answer:
