@@ -1,20 +1,20 @@
 // The server thread: poll() over the listening socket, every connection and a wake-up
 // eventfd, and never a blocking call on one connection.
 //
-//   PLC ──────┐  (plc_address: slots of its own, never closed for anyone else)
+//   PLC ──────┐  (plc_address: slots of its own, never closed for others)
 //   HMI ──────┼─ poll() ─ whole frame collected? ─ checked ─ modbus_reply(): registers
 //   laptop ───┘  (max_clients slots)                    └─ modbus_reply_exception()
 //
-// Invariant: no other client can delay or disconnect the PLC. Each connection's bytes
-// are collected until a whole Modbus TCP frame (MBAP header + PDU) is there, and only
-// then answered. libmodbus's modbus_receive() is not used for this: it waits without a
-// timeout for a request's first bytes and then up to byte_timeout for each further
-// chunk, so a silent client or one that sends half a request would hold up every other
-// one. Requests are checked here before libmodbus sees them, because modbus_reply()
-// sleeps response_timeout and flushes the socket on a bad register count, and would
-// write into the mapping. A client that sends something that is not Modbus TCP is
-// disconnected; a well-formed request it may not make gets the exception docs/modbus.md
-// lists, and the connection stays open.
+// Invariant: no other client can disconnect the PLC or hold up its answers. Each
+// connection's bytes are collected until a whole Modbus TCP frame (MBAP header + PDU)
+// is there, and only then answered. libmodbus's modbus_receive() is not used for this:
+// it waits without a timeout for a request's first bytes and then up to byte_timeout
+// for each further chunk, so a silent client or one that sends half a request would
+// hold up every other one. Requests are checked here before libmodbus sees them,
+// because modbus_reply() sleeps response_timeout and flushes the socket on a bad
+// register count, and would write into the mapping. A client that sends something that
+// is not Modbus TCP is disconnected; a well-formed request it may not make gets the
+// exception docs/modbus.md lists, and the connection stays open.
 //
 // A new connection from outside `allow`, or from another client while max_clients are
 // connected, is closed at once: an active client is never evicted for a newcomer, and

@@ -227,8 +227,8 @@ class ServerMode(unittest.TestCase):
         for line in ["Modbus TCP server listening on 127.0.0.1:%d" % cls.port,
                      "Modbus client connected from 127.0.0.1:",
                      "disconnected",
-                     "sent bytes that are not Modbus TCP (protocol id 21536, length 12064; expected "
-                     "protocol id 0 and length 2..254); disconnected",
+                     "sent bytes that are not Modbus TCP (protocol id 21536, length 12064; "
+                     "expected protocol id 0 and length 2..254); disconnected",
                      "refused function 6 from 127.0.0.1:"]:
             assert line in log, "%r not logged:\n%s" % (line, log)
 
@@ -550,7 +550,8 @@ class Connections(unittest.TestCase):
                  counts), file=sys.stderr)
         self.assertLess(latencies[-1], 0.5)  # far inside the PLC's 1 s timeout
         # Connected, and disconnected only when the PLC itself left after the crowd.
-        plc_lines = [line for line in log.splitlines() if "Modbus client" in line and PLC_HOST in line]
+        plc_lines = [line for line in log.splitlines()
+                     if "Modbus client" in line and PLC_HOST in line]
         self.assertEqual(len(plc_lines), 2, plc_lines)
         self.assertRegex(plc_lines[0], r"Modbus client connected from 127\.0\.0\.2:\d+ \(PLC\)$")
         self.assertRegex(plc_lines[1], r"Modbus client 127\.0\.0\.2:\d+ \(PLC\) disconnected$")
@@ -652,8 +653,9 @@ class Connections(unittest.TestCase):
                 self.assertEqual(receive_frame(sender), exception_frame(5, 1, 3, 3))
                 read = struct.pack(">HHHBBHH", 6, 0, 6, 1, 3, STATUS, 1)
                 sender.sendall(read + read.replace(b"\0\6\0\0", b"\0\7\0\0", 1))
-                self.assertEqual(receive_frame(sender)[:9], struct.pack(">HHHBBB", 6, 0, 5, 1, 3, 2))
-                self.assertEqual(receive_frame(sender)[:9], struct.pack(">HHHBBB", 7, 0, 5, 1, 3, 2))
+                for transaction in (6, 7):
+                    self.assertEqual(receive_frame(sender)[:9],
+                                     struct.pack(">HHHBBB", transaction, 0, 5, 1, 3, 2))
             time.sleep(0.2)
         finally:
             plc.stop()
