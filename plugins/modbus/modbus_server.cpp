@@ -1,19 +1,25 @@
 // The server thread: poll() over the listening socket, every connection and a wake-up
 // eventfd, and never a blocking call on one connection.
 //
-//   PLC A ──┐
-//   PLC B ──┼─ poll() ─ whole frame collected? ─ checked ─ modbus_reply(): registers
-//   tool  ──┘                                          └─ modbus_reply_exception()
+//   PLC ──────┐  (plc_address: slots of its own, never closed for others)
+//   HMI ──────┼─ poll() ─ whole frame collected? ─ checked ─ modbus_reply(): registers
+//   laptop ───┘  (max_clients slots)                    └─ modbus_reply_exception()
 //
-// Invariant: one client cannot delay or disturb another. Each connection's bytes are
-// collected until a whole Modbus TCP frame (MBAP header + PDU) is there, and only then
-// answered. libmodbus's modbus_receive() is not used for this: after the first bytes of
-// a frame it waits up to byte_timeout for the rest, so a client that sends half a
-// request would hold up every other one. Requests are checked here before libmodbus sees
-// them, because modbus_reply() sleeps response_timeout and flushes the socket on a bad
+// Invariant: no other client can disconnect the PLC or hold up its answers. Each
+// connection's bytes are collected until a whole Modbus TCP frame (MBAP header + PDU)
+// is there, and only then answered. libmodbus's modbus_receive() is not used for this:
+// it waits without a timeout for a request's first bytes and then up to byte_timeout
+// for each further chunk, so a silent client or one that sends half a request would
+// hold up every other one. Requests are checked here before libmodbus sees them,
+// because modbus_reply() sleeps response_timeout and flushes the socket on a bad
 // register count, and would write into the mapping. A client that sends something that
 // is not Modbus TCP is disconnected; a well-formed request it may not make gets the
 // exception docs/modbus.md lists, and the connection stays open.
+//
+// A new connection from outside `allow`, or from another client while max_clients are
+// connected, is closed at once: an active client is never evicted for a newcomer, and
+// idle ones leave by idle_timeout. Events that may come in floods (refusals, idle
+// closes, other clients' connects and protocol errors) are logged through LogThrottles.
 //
 // The mapping belongs to this thread alone; only the LatestMeasurement it reads from is
 // shared with the graph (under that object's mutex).
@@ -23,6 +29,7 @@
 #include <array>
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -36,18 +43,32 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "log_throttle.h"
 #include "tilth/error.h"
 
 namespace tilth::modbus {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
 
 constexpr std::size_t kMbapSize = 7;             // transaction, protocol, length, unit
 constexpr std::size_t kMaxLengthField = 254;     // unit id + the largest PDU (253 bytes)
 constexpr std::uint8_t kThisDeviceUnit = 0xFF;   // Modbus TCP: "the device itself"
 constexpr std::uint8_t kUnaddressedUnit = 0x00;  // what many TCP masters send by default
-constexpr std::chrono::milliseconds kHeartbeatPeriod{10};
+constexpr milliseconds kHeartbeatPeriod{10};
+// A burst of connections waits in the kernel instead of being dropped before accept()
+// sees it (the kernel caps this at net.core.somaxconn).
+constexpr int kListenBacklog = SOMAXCONN;
+// Connections accepted per wake-up, so a flood of them cannot starve the PLC's requests.
+constexpr int kAcceptsPerWake = 64;
+// At most one line per this period for each kind of event that may come in floods.
+constexpr milliseconds kLogPeriod{10000};
+// TCP keepalive on the PLC's connections, which are never closed for being idle: a PLC
+// that vanished (power cut, cable pulled) is noticed some 5 s after its last request.
+constexpr int kKeepaliveIdleS = 2;
+constexpr int kKeepaliveIntervalS = 1;
+constexpr int kKeepaliveProbes = 3;
 
 std::uint16_t word_at(std::span<const std::uint8_t> bytes, std::size_t offset) {
   return static_cast<std::uint16_t>(bytes[offset] << 8 | bytes[offset + 1]);
@@ -59,20 +80,44 @@ std::string peer_name(const sockaddr_in& address) {
   return std::string(text) + ":" + std::to_string(ntohs(address.sin_port));
 }
 
+std::string ms_text(Clock::duration duration) {
+  return std::to_string(std::chrono::duration_cast<milliseconds>(duration).count()) + " ms";
+}
+
+void keep_alive(int fd) {
+  const int on = 1;
+  setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &on, sizeof on);
+  setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &kKeepaliveIdleS, sizeof kKeepaliveIdleS);
+  setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &kKeepaliveIntervalS, sizeof kKeepaliveIntervalS);
+  setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &kKeepaliveProbes, sizeof kKeepaliveProbes);
+}
+
 struct Connection {
   int fd = -1;
   std::string peer;
+  bool plc = false;
   std::vector<std::uint8_t> pending;  // bytes of a frame not yet complete
   Clock::time_point last_request;     // the time of connecting until the first request
   bool warned = false;  // the first refused request is a warning, later ones debug lines
 };
+
+// Why a connection ends, which decides how it is logged.
+enum class Ending { kLeft, kFailed, kNotModbus, kIdle };
 
 }  // namespace
 
 class ModbusServer::Connections {
  public:
   Connections(const ServerOptions& options, const LatestMeasurement& latest, Logger log)
-      : options_(options), latest_(latest), log_(std::move(log)), started_(Clock::now()) {
+      : options_(options),
+        latest_(latest),
+        log_(std::move(log)),
+        started_(Clock::now()),
+        comings_and_goings_(log_, LogLevel::kInfo, kLogPeriod),
+        refused_outsiders_(log_, LogLevel::kWarning, kLogPeriod),
+        refused_when_full_(log_, LogLevel::kWarning, kLogPeriod),
+        idle_closes_(log_, LogLevel::kInfo, kLogPeriod),
+        protocol_errors_(log_, LogLevel::kWarning, kLogPeriod) {
     const std::string where = options.address + ":" + std::to_string(options.port);
     context_ = modbus_new_tcp(options.address.c_str(), options.port);
     if (context_ == nullptr) {
@@ -85,7 +130,7 @@ class ModbusServer::Connections {
       release();
       throw Error("cannot allocate the register mapping");
     }
-    listen_fd_ = modbus_tcp_listen(context_, options.max_clients);
+    listen_fd_ = modbus_tcp_listen(context_, kListenBacklog);
     if (listen_fd_ == -1) {
       const int error = errno;
       release();
@@ -96,7 +141,7 @@ class ModbusServer::Connections {
     ::fcntl(listen_fd_, F_SETFL, ::fcntl(listen_fd_, F_GETFL) | O_NONBLOCK);
     log_.info("Modbus TCP server listening on " + where + ", unit " +
               std::to_string(options.unit_id) + ", registers " + std::to_string(base) + ".." +
-              std::to_string(base + kRegisterCount - 1));
+              std::to_string(base + kRegisterCount - 1) + "; " + policy_text());
   }
 
   ~Connections() {
@@ -113,17 +158,23 @@ class ModbusServer::Connections {
     for (;;) {
       polled.assign({{wake_fd, POLLIN, 0}, {listen_fd_, POLLIN, 0}});
       for (const auto& connection : connections_) polled.push_back({connection.fd, POLLIN, 0});
-      if (::poll(polled.data(), polled.size(), -1) == -1) {
+      if (::poll(polled.data(), polled.size(), poll_timeout_ms(Clock::now())) == -1) {
         if (errno == EINTR) continue;
         log_.error(std::string("Modbus server stopped: poll failed: ") + std::strerror(errno));
         return;
       }
-      if (polled[0].revents != 0) return;
+      if (polled[0].revents != 0) {
+        for (LogThrottle* throttle : throttles()) throttle->summarize(Clock::now());
+        return;
+      }
       for (std::size_t i = 0; i < connections_.size(); ++i) {
         if (polled[i + 2].revents != 0) receive(connections_[i]);
       }
+      const auto now = Clock::now();
+      close_idle(now);
       std::erase_if(connections_, [](const Connection& c) { return c.fd == -1; });
-      if (polled[1].revents != 0) accept_connection();
+      if (polled[1].revents != 0) accept_connections(now);
+      for (LogThrottle* throttle : throttles()) throttle->flush(now);
     }
   }
 
@@ -136,35 +187,142 @@ class ModbusServer::Connections {
     modbus_free(context_);
   }
 
-  void accept_connection() {
-    sockaddr_in address{};
-    socklen_t length = sizeof address;
-    const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length,
-                             SOCK_NONBLOCK | SOCK_CLOEXEC);
-    if (fd == -1) {
-      const int error = errno;
-      if (error != EAGAIN && error != EWOULDBLOCK && error != ECONNABORTED && error != EINTR) {
-        log_.error(std::string("cannot accept a connection: ") + std::strerror(error));
+  std::string policy_text() const {
+    std::string text = "PLC " + (options_.plc.empty()
+                                     ? std::string("addresses: none")
+                                     : options_.plc.text() + " (" +
+                                           std::to_string(options_.plc_clients) + " connections)");
+    text += ", other clients: " + std::to_string(options_.max_clients);
+    if (!options_.allow.empty()) text += " from " + options_.allow.text();
+    text +=
+        ", idle timeout " +
+        (options_.idle_timeout.count() == 0 ? std::string("none") : ms_text(options_.idle_timeout));
+    return text;
+  }
+
+  std::array<LogThrottle*, 5> throttles() {
+    return {&comings_and_goings_, &refused_outsiders_, &refused_when_full_, &idle_closes_,
+            &protocol_errors_};
+  }
+
+  bool idle_timeout_applies(const Connection& connection) const {
+    return !connection.plc && options_.idle_timeout.count() > 0;
+  }
+
+  // Until the next idle timeout or log summary is due; -1 (forever) when none is.
+  int poll_timeout_ms(Clock::time_point now) {
+    std::optional<Clock::time_point> next;
+    const auto earlier = [&next](Clock::time_point at) { next = next ? std::min(*next, at) : at; };
+    for (const auto& connection : connections_) {
+      if (idle_timeout_applies(connection))
+        earlier(connection.last_request + options_.idle_timeout);
+    }
+    for (LogThrottle* throttle : throttles()) {
+      if (const auto deadline = throttle->deadline()) earlier(*deadline);
+    }
+    if (!next) return -1;
+    // Rounded up, so that the deadline has passed when poll() returns.
+    const auto wait = std::chrono::ceil<milliseconds>(*next - now).count();
+    return static_cast<int>(std::clamp<std::int64_t>(wait, 0, 60000));
+  }
+
+  void close_idle(Clock::time_point now) {
+    for (auto& connection : connections_) {
+      if (connection.fd != -1 && idle_timeout_applies(connection) &&
+          now - connection.last_request >= options_.idle_timeout) {
+        close(connection, Ending::kIdle,
+              "closed: no request for " + ms_text(now - connection.last_request) +
+                  " (idle_timeout_ms " + std::to_string(options_.idle_timeout.count()) + ")");
       }
-      return;
+    }
+  }
+
+  void accept_connections(Clock::time_point now) {
+    for (int i = 0; i < kAcceptsPerWake; ++i) {
+      sockaddr_in address{};
+      socklen_t length = sizeof address;
+      const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length,
+                               SOCK_NONBLOCK | SOCK_CLOEXEC);
+      if (fd == -1) {
+        const int error = errno;
+        if (error == ECONNABORTED || error == EINTR) continue;
+        if (error != EAGAIN && error != EWOULDBLOCK) {
+          log_.error(std::string("cannot accept a connection: ") + std::strerror(error));
+        }
+        return;
+      }
+      const std::uint32_t peer_address = ntohl(address.sin_addr.s_addr);
+      admit(Connection{fd, peer_name(address), options_.plc.contains(peer_address), {}, now, false},
+            peer_address, now);
+    }
+  }
+
+  // Keeps `connection`, or closes it at once with the reason logged.
+  void admit(Connection connection, std::uint32_t address, Clock::time_point now) {
+    if (!connection.plc && !options_.allow.empty() && !options_.allow.contains(address)) {
+      return refuse(connection, refused_outsiders_, now,
+                    "not in 'allow' (" + options_.allow.text() + ")");
+    }
+    const int slots = connection.plc ? options_.plc_clients : options_.max_clients;
+    // A client that reconnects at once must find the slot of its old connection free,
+    // also when that connection's end arrived after poll() returned.
+    if (taken(connection.plc) >= slots) serve_ready_connections();
+    if (connection.plc) {
+      if (taken(true) >= slots) make_room_for_plc(connection, now);
+      keep_alive(connection.fd);
+    } else if (taken(false) >= slots) {
+      return refuse(connection, refused_when_full_, now,
+                    "max_clients (" + std::to_string(slots) + ") other clients are connected");
     }
     const int on = 1;
-    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);  // answers are single packets
-    Connection connection{fd, peer_name(address), {}, Clock::now(), false};
-    if (connections_.size() >= static_cast<std::size_t>(options_.max_clients)) {
-      // A PLC that lost its link reconnects while its old connection still looks open:
-      // make room by dropping the connection that has been quiet longest.
-      auto quietest = std::min_element(
-          connections_.begin(), connections_.end(),
-          [](const Connection& a, const Connection& b) { return a.last_request < b.last_request; });
-      log_.warning("max_clients (" + std::to_string(options_.max_clients) +
-                   ") reached: closing the quietest connection, from " + quietest->peer +
-                   ", to accept " + connection.peer);
-      ::close(quietest->fd);
-      connections_.erase(quietest);
+    setsockopt(connection.fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);  // one packet each
+    const std::string what = "Modbus client connected from " + connection.peer;
+    if (connection.plc) {
+      log_.info(what + " (PLC)");
+    } else {
+      comings_and_goings_.event(now, what);
     }
-    log_.info("Modbus client connected from " + connection.peer);
     connections_.push_back(std::move(connection));
+  }
+
+  // The PLC's connections, or the other clients'.
+  int taken(bool plc) const {
+    return static_cast<int>(std::count_if(connections_.begin(), connections_.end(),
+                                          [plc](const Connection& c) { return c.plc == plc; }));
+  }
+
+  // Reads and answers what has arrived on any connection by now, without waiting.
+  void serve_ready_connections() {
+    std::vector<pollfd> polled;
+    for (const auto& connection : connections_) polled.push_back({connection.fd, POLLIN, 0});
+    if (::poll(polled.data(), polled.size(), 0) <= 0) return;
+    for (std::size_t i = 0; i < connections_.size(); ++i) {
+      if (polled[i].revents != 0) receive(connections_[i]);
+    }
+    std::erase_if(connections_, [](const Connection& c) { return c.fd == -1; });
+  }
+
+  // A PLC that lost its link reconnects while its old connection still looks open: the
+  // PLC connection quiet longest makes room (keepalive would only close it seconds later).
+  void make_room_for_plc(const Connection& newcomer, Clock::time_point now) {
+    auto quietest = connections_.end();
+    for (auto it = connections_.begin(); it != connections_.end(); ++it) {
+      if (it->plc &&
+          (quietest == connections_.end() || it->last_request < quietest->last_request)) {
+        quietest = it;
+      }
+    }
+    log_.warning("plc_clients (" + std::to_string(options_.plc_clients) +
+                 ") PLC connections open: closing the one from " + quietest->peer + ", quiet for " +
+                 ms_text(now - quietest->last_request) + ", to accept " + newcomer.peer);
+    ::close(quietest->fd);
+    connections_.erase(quietest);
+  }
+
+  void refuse(Connection& connection, LogThrottle& throttle, Clock::time_point now,
+              const std::string& why) {
+    ::close(connection.fd);
+    throttle.event(now, "refused the connection from " + connection.peer + ": " + why);
   }
 
   // Reads what the socket has and answers every whole frame; closes the connection on
@@ -172,11 +330,11 @@ class ModbusServer::Connections {
   void receive(Connection& connection) {
     std::array<std::uint8_t, 512> buffer;
     const ssize_t received = ::recv(connection.fd, buffer.data(), buffer.size(), 0);
-    if (received == 0) return close(connection, LogLevel::kInfo, "disconnected");
+    if (received == 0) return close(connection, Ending::kLeft, "disconnected");
     if (received < 0) {
       const int error = errno;
       if (error == EAGAIN || error == EWOULDBLOCK || error == EINTR) return;
-      return close(connection, LogLevel::kWarning,
+      return close(connection, Ending::kFailed,
                    std::string("receive failed: ") + std::strerror(error));
     }
     auto& pending = connection.pending;
@@ -185,26 +343,27 @@ class ModbusServer::Connections {
       const std::uint16_t protocol = word_at(pending, 2);
       const std::uint16_t length = word_at(pending, 4);
       if (protocol != 0 || length < 2 || length > kMaxLengthField) {
-        return close(connection, LogLevel::kWarning,
+        return close(connection, Ending::kNotModbus,
                      "sent bytes that are not Modbus TCP (protocol id " + std::to_string(protocol) +
-                         ", length " + std::to_string(length) + "); disconnected");
+                         ", length " + std::to_string(length) +
+                         "; expected protocol id 0 and length 2.." +
+                         std::to_string(kMaxLengthField) + "); disconnected");
       }
       const std::size_t frame_size = 6 + length;
       if (pending.size() < frame_size) return;
       if (pending[kMbapSize] >= 0x80) {
-        return close(connection, LogLevel::kWarning,
+        return close(connection, Ending::kNotModbus,
                      "sent function code " + std::to_string(pending[kMbapSize]) +
                          ", which is not a request; disconnected");
       }
       if (!answer(connection, std::span<const std::uint8_t>(pending.data(), frame_size))) {
         const int error = errno;
-        return close(connection, LogLevel::kWarning,
+        return close(connection, Ending::kFailed,
                      std::string("send failed: ") + modbus_strerror(error));
       }
       pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(frame_size));
     }
   }
-
   // The exception code a well-formed frame gets, or 0 when it is a read to serve.
   int check(std::span<const std::uint8_t> frame) const {
     const std::uint8_t unit = frame[kMbapSize - 1];
@@ -262,10 +421,25 @@ class ModbusServer::Connections {
     return modbus_reply(context_, frame.data(), static_cast<int>(frame.size()), mapping_) != -1;
   }
 
-  void close(Connection& connection, LogLevel level, const std::string& why) {
-    log(level, log_.where(), "Modbus client " + connection.peer + " " + why);
+  // The PLC's connection ends are logged each; other clients' through the throttles.
+  void close(Connection& connection, Ending ending, const std::string& why) {
     ::close(connection.fd);
     connection.fd = -1;
+    const auto now = Clock::now();
+    if (connection.plc) {
+      const LogLevel level = ending == Ending::kLeft ? LogLevel::kInfo : LogLevel::kWarning;
+      return log(level, log_.where(), "Modbus client " + connection.peer + " (PLC) " + why);
+    }
+    const std::string what = "Modbus client " + connection.peer + " " + why;
+    switch (ending) {
+      case Ending::kLeft:
+      case Ending::kFailed:
+        return comings_and_goings_.event(now, what);
+      case Ending::kNotModbus:
+        return protocol_errors_.event(now, what);
+      case Ending::kIdle:
+        return idle_closes_.event(now, what);
+    }
   }
 
   const ServerOptions options_;
@@ -276,6 +450,11 @@ class ModbusServer::Connections {
   modbus_mapping_t* mapping_ = nullptr;
   int listen_fd_ = -1;
   std::vector<Connection> connections_;
+  LogThrottle comings_and_goings_;
+  LogThrottle refused_outsiders_;
+  LogThrottle refused_when_full_;
+  LogThrottle idle_closes_;
+  LogThrottle protocol_errors_;
 };
 
 ModbusServer::ModbusServer(const ServerOptions& options, const LatestMeasurement& latest,

@@ -2,12 +2,13 @@
 // own serves every connection; the graph only updates the LatestMeasurement it reads.
 #pragma once
 
-#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <thread>
 
+#include "ipv4_ranges.h"
 #include "latest_measurement.h"
 #include "register_map.h"
 #include "tilth/log.h"
@@ -20,7 +21,15 @@ struct ServerOptions {
   int unit_id = 1;
   int base_register = 0;
   WordOrder word_order = WordOrder::kHighFirst;
+  // Who may connect (docs/modbus.md, "Connections"). The PLC's connections have slots
+  // of their own and are never closed to make room or for being idle; other clients
+  // share max_clients slots, are refused when those are taken, and are closed after
+  // idle_timeout without a request (zero: never).
+  Ipv4Ranges plc;
+  int plc_clients = 2;
+  Ipv4Ranges allow;  // empty: every address; the PLC's are always allowed
   int max_clients = 8;
+  std::chrono::milliseconds idle_timeout{5000};
 };
 
 class ModbusServer {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <memory>
 
+#include "ipv4_ranges.h"
 #include "latest_measurement.h"
 #include "modbus_client.h"
 #include "modbus_server.h"
@@ -54,7 +55,11 @@ class ModbusOutput final : public Sink {
     } else {
       server_ = std::make_unique<ModbusServer>(
           ServerOptions{address, port, unit_id, base_register, word_order,
-                        static_cast<int>(params.integer("max_clients"))},
+                        Ipv4Ranges::parse("plc_address", params.json("plc_address")),
+                        static_cast<int>(params.integer("plc_clients")),
+                        Ipv4Ranges::parse("allow", params.json("allow")),
+                        static_cast<int>(params.integer("max_clients")),
+                        std::chrono::milliseconds(params.integer("idle_timeout_ms"))},
           latest_, context.log);
     }
   }
@@ -123,9 +128,20 @@ StageDescriptor describe() {
           .range(1, 60000)
           .in_unit("ms")
           .describe("client: time between writes"),
+      ParamSpec::json("plc_address", nlohmann::json::array())
+          .describe("server: the PLC's IPv4 addresses or CIDR blocks; slots of their own"),
+      ParamSpec::integer("plc_clients", 2)
+          .range(1, 16)
+          .describe("server: connections kept for the PLC; never closed for other clients"),
+      ParamSpec::json("allow", nlohmann::json::array())
+          .describe("server: IPv4 addresses or CIDR blocks other clients may come from; [] = any"),
       ParamSpec::integer("max_clients", 8)
           .range(1, 256)
-          .describe("server: connections served at once; the quietest makes room"),
+          .describe("server: other clients served at once; more are refused"),
+      ParamSpec::integer("idle_timeout_ms", 5000)
+          .range(0, 600000)
+          .in_unit("ms")
+          .describe("server: other clients without a request for this long are closed; 0 = never"),
   };
   d.create = factory<ModbusOutput>();
   return d;

@@ -5,11 +5,16 @@
   for register, the CSV row of the frame its frame counter names; the output goes stale
   when the source stops; the heartbeat keeps counting; bad requests get the documented
   exception codes, garbage and silent clients harm no one else.
+- connections (server mode): a PLC polling every 20 ms through a crowd of 50 other
+  pollers, idle bursts, garbage and slowloris senders is never disconnected and reads
+  the right distance every time; idle clients are closed on time, addresses outside
+  `allow` and clients beyond `max_clients` at once.
 - client mode: Tilth writes into a pymodbus server standing in for the PLC, finds it
   when it comes up late, and again after it restarts.
 """
 import csv
 import json
+import math
 import os
 import re
 import signal
@@ -28,6 +33,7 @@ TILTH = os.environ["TILTH_BIN"]
 PLUGIN_DIR = os.environ["TILTH_TEST_PLUGIN_DIR"]
 MBPOLL = os.environ["MBPOLL"]
 PLC_SERVER = os.environ["PLC_SERVER"]
+CROWD = os.environ["CROWD"]
 
 # The register map (docs/modbus.md), offsets from base_register.
 DISTANCE_HUNDREDTHS, DISTANCE_FLOAT, FRAME, STATUS, SOIL, CONFIDENCE, HEARTBEAT, AGE, CAUSE = (
@@ -196,7 +202,7 @@ class ServerMode(unittest.TestCase):
         cls.run_ = TilthRun(
             cls.tmp.name,
             {"mode": "server", "address": "127.0.0.1", "port": cls.port,
-             "stale_timeout_ms": STALE_TIMEOUT_MS, "max_clients": 4},
+             "stale_timeout_ms": STALE_TIMEOUT_MS},
             {"frames": FRAMES, "fps": 50, "then": "idle", "first_frame_id": FIRST_FRAME_ID,
              "invalid_every": INVALID_EVERY})
         wait_for_port(cls.port)
@@ -224,7 +230,8 @@ class ServerMode(unittest.TestCase):
         for line in ["Modbus TCP server listening on 127.0.0.1:%d" % cls.port,
                      "Modbus client connected from 127.0.0.1:",
                      "disconnected",
-                     "sent bytes that are not Modbus TCP (protocol id 21536, length 12064)",
+                     "sent bytes that are not Modbus TCP (protocol id 21536, length 12064; "
+                     "expected protocol id 0 and length 2..254); disconnected",
                      "refused function 6 from 127.0.0.1:"]:
             assert line in log, "%r not logged:\n%s" % (line, log)
 
@@ -396,19 +403,301 @@ class ServerMode(unittest.TestCase):
             thread.join()
         self.assertEqual(failures, [])
 
-    def test_a_new_master_beyond_max_clients_replaces_the_quietest(self):
-        sockets = [socket.create_connection(("127.0.0.1", self.port), timeout=2) for _ in range(4)]
+
+PLC_HOST = "127.0.0.2"  # the loopback network is 127.0.0.0/8: a PLC of its own address
+OUTSIDER_HOST = "127.0.0.3"
+IDLE_TIMEOUT_MS = 1000
+POLICY_FIRST_FRAME = 1000
+
+
+def sequence_distance(frame):
+    """The distance testdistance.sequence gives `frame` (start 518.23, step 0.37 mm),
+    rounded to 0.01 mm as it does (half away from zero)."""
+    return math.floor((518.23 + 0.37 * (frame - POLICY_FIRST_FRAME)) * 100.0 + 0.5) / 100.0
+
+
+def connect_from(host, port):
+    return socket.create_connection(("127.0.0.1", port), timeout=2, source_address=(host, 0))
+
+
+def closed_within(connection, seconds):
+    """How long until the server closed `connection` (sending nothing), or None."""
+    start = time.monotonic()
+    connection.settimeout(seconds)
+    try:
+        data = connection.recv(1)
+    except socket.timeout:
+        return None
+    except ConnectionResetError:  # closed with what the client sent still unread
+        return time.monotonic() - start
+    if data != b"":
+        raise AssertionError("the server sent %r instead of closing" % data)
+    return time.monotonic() - start
+
+
+def read_block(connection, transaction=1):
+    return request(connection, transaction, 1, struct.pack(">BHH", 3, 0, COUNT))
+
+
+class PlcPoller(threading.Thread):
+    """The PLC: pymodbus from PLC_HOST reading the block every 20 ms until stopped; keeps
+    every poll's (latency s, registers or error, local address of its connection)."""
+
+    def __init__(self, port):
+        super().__init__()
+        self.client = ModbusTcpClient("127.0.0.1", port=port, timeout=1,
+                                      source_address=(PLC_HOST, 0))
+        self.polls = []
+        self.stopping = threading.Event()
+
+    def run(self):
+        self.client.connect()
+        next_poll = time.monotonic()
+        while not self.stopping.is_set():
+            start = time.monotonic()
+            try:
+                result = self.client.read_holding_registers(0, COUNT, slave=1)
+                outcome = result if result.isError() else list(result.registers)
+            except Exception as error:  # pylint: disable=broad-except
+                outcome = error
+            local = self.client.socket.getsockname() if self.client.socket else None
+            self.polls.append((time.monotonic() - start, outcome, local))
+            next_poll += 0.02
+            self.stopping.wait(max(0.0, next_poll - time.monotonic()))
+        self.client.close()
+
+    def stop(self):
+        self.stopping.set()
+        self.join(timeout=10)
+
+
+class Connections(unittest.TestCase):
+    """Server mode with a PLC at PLC_HOST, `allow` = 127.0.0.1, idle timeout 1 s: each test
+    with a run of its own, an endless sequence at 50 fps."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.port = free_port()
+        self.run_ = TilthRun(
+            self.tmp.name,
+            {"mode": "server", "address": "127.0.0.1", "port": self.port,
+             "plc_address": PLC_HOST, "allow": ["127.0.0.1/32"], "max_clients": 8,
+             "idle_timeout_ms": IDLE_TIMEOUT_MS},
+            {"frames": 0, "fps": 50, "first_frame_id": POLICY_FIRST_FRAME})
+        wait_for_port(self.port)
+        deadline = time.monotonic() + 10
+        while decode(pymodbus_read(self.port))["status"] & STALE:  # until the first frame
+            self.assertLess(time.monotonic(), deadline, "no measurement arrives")
+            time.sleep(0.02)
+
+    def tearDown(self):
+        code, log = self.run_.stop()
+        self.tmp.cleanup()
+        self.assertEqual(code, 0, log)
+
+    def stop(self):
+        """Stops the run before the test ends; returns what it logged."""
+        code, log = self.run_.stop()
+        self.assertEqual(code, 0, log)
+        return log
+
+    def assert_the_right_distance(self, registers):
+        values = decode(registers)
+        distance = sequence_distance(values["frame"])
+        self.assertEqual(values["status"] & (VALID | STALE), VALID, registers)
+        self.assertEqual(values["hundredths"], round(distance * 100), registers)
+        self.assertEqual(values["float_bits"],
+                         struct.unpack(">I", struct.pack(">f", distance))[0], registers)
+        self.assertEqual(values["soil"], (values["frame"] - POLICY_FIRST_FRAME) % 97 * 100 + 12)
+        self.assertLess(values["age"], STALE_TIMEOUT_MS)
+        return values["frame"]
+
+    def test_the_plc_is_served_through_a_crowd(self):
+        seconds = 8
+        plc = PlcPoller(self.port)
+        plc.start()
+        time.sleep(0.2)
+        crowd_output = os.path.join(self.tmp.name, "crowd.txt")
+        with open(crowd_output, "w") as output:
+            crowd = subprocess.Popen([sys.executable, CROWD, str(self.port), str(seconds)],
+                                     stdout=output, stderr=subprocess.STDOUT)
+            try:
+                crowd.wait(timeout=seconds + 20)
+            finally:
+                if crowd.poll() is None:
+                    crowd.kill()
+                    crowd.wait()
+        time.sleep(0.2)
+        plc.stop()
+        log = self.stop()
+        with open(crowd_output) as output:
+            crowd_text = output.read(10000)
+        counts = json.loads(crowd_text.splitlines()[-1])
+
+        # The crowd was really there: some of its pollers served, many turned away.
+        self.assertGreater(counts["answered"], 100, crowd_text)
+        self.assertGreater(counts["closed"] + counts["failed"], 100, crowd_text)
+        # Every poll of the PLC answered, on one connection, with the sequence's distance.
+        self.assertGreaterEqual(len(plc.polls), seconds * 50 * 0.7)
+        self.assertEqual([outcome for _, outcome, _ in plc.polls if not isinstance(outcome, list)],
+                         [])
+        connections = {local for _, _, local in plc.polls}
+        self.assertEqual(len(connections), 1, connections)
+        frames = [self.assert_the_right_distance(registers) for _, registers, _ in plc.polls]
+        self.assertEqual(frames, sorted(frames))
+        self.assertGreater(frames[-1] - frames[0], seconds * 50 * 0.7)
+        latencies = sorted(latency for latency, _, _ in plc.polls)
+        print("\nPLC polls: %d, latency median %.1f ms, 99th %.1f ms, max %.1f ms; crowd %s"
+              % (len(latencies), latencies[len(latencies) // 2] * 1000,
+                 latencies[len(latencies) * 99 // 100] * 1000, latencies[-1] * 1000,
+                 counts), file=sys.stderr)
+        self.assertLess(latencies[-1], 0.5)  # far inside the PLC's 1 s timeout
+        # Connected, and disconnected only when the PLC itself left after the crowd.
+        plc_lines = [line for line in log.splitlines()
+                     if "Modbus client" in line and PLC_HOST in line]
+        self.assertEqual(len(plc_lines), 2, plc_lines)
+        self.assertRegex(plc_lines[0], r"Modbus client connected from 127\.0\.0\.2:\d+ \(PLC\)$")
+        self.assertRegex(plc_lines[1], r"Modbus client 127\.0\.0\.2:\d+ \(PLC\) disconnected$")
+        # Each kind of flood is one line, then one summing up the rest (here when the run
+        # stops, before 10 s are over): refusals of outsiders and when full, idle closes,
+        # protocol errors, comings and goings; plus the run's own lines.
+        for what in [r"refused the connection from 127\.0\.0\.3:\d+: not in 'allow'",
+                     r"refused the connection from 127\.0\.0\.1:\d+: max_clients \(8\)",
+                     r"\d\d+ more like it in the last \d s; the latest: refused the connection "
+                     r"from 127\.0\.0\.3",
+                     r"\d{3,} more like it in the last \d s; the latest: refused the connection "
+                     r"from 127\.0\.0\.1",
+                     r"closed: no request for 1\d\d\d ms", "sent bytes that are not Modbus TCP",
+                     "Modbus client connected from 127.0.0.1:"]:
+            self.assertRegex(log, what)
+        self.assertLess(len(log.splitlines()), 30, log)
+
+    def test_idle_clients_are_closed_after_the_timeout_not_the_plc(self):
+        timeout = IDLE_TIMEOUT_MS / 1000
+        start = time.monotonic()  # the server accepts each connection after this
+        with connect_from("127.0.0.1", self.port) as silent, \
+                connect_from("127.0.0.1", self.port) as quiet, \
+                connect_from("127.0.0.1", self.port) as slow, \
+                connect_from(PLC_HOST, self.port) as plc:
+            slow.sendall(b"\0")  # a request's first bytes, one at a time
+            time.sleep(0.5)
+            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(quiet)[9:])))
+            for _ in range(3):
+                time.sleep(0.1)
+                slow.sendall(b"\0")
+            silent_closed = time.monotonic() - start + closed_within(silent, 2)
+            slow_closed = time.monotonic() - start + closed_within(slow, 2)
+            quiet_closed = time.monotonic() - start + closed_within(quiet, 2)
+            # Not before the timeout; afterwards within one poll wake-up and scheduling.
+            self.assertGreaterEqual(silent_closed, timeout)
+            self.assertLess(silent_closed, timeout + 0.3)
+            self.assertGreaterEqual(slow_closed, timeout)  # bytes are not requests
+            self.assertLess(slow_closed, timeout + 0.3)
+            self.assertGreaterEqual(quiet_closed, 0.5 + timeout)  # from its request
+            self.assertLess(quiet_closed, 0.5 + timeout + 0.3)
+            # The PLC's silent connection stays, and is served.
+            self.assertIsNone(closed_within(plc, 0.6))
+            self.assertGreater(time.monotonic() - start, 2 * timeout)
+            plc.settimeout(2)
+            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(plc)[9:])))
+        log = self.stop()
+        self.assertRegex(log, r"Modbus client 127\.0\.0\.1:\d+ closed: no request for 1\d\d\d ms "
+                              r"\(idle_timeout_ms 1000\)")
+
+    def test_an_address_outside_allow_is_closed_at_once(self):
+        with connect_from(OUTSIDER_HOST, self.port) as outsider:
+            outsider.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 3, 0, COUNT))
+            self.assertLess(closed_within(outsider, 1), 0.2)
+        with connect_from("127.0.0.1", self.port) as allowed:
+            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(allowed)[9:])))
+        log = self.stop()
+        self.assertRegex(log, r"refused the connection from 127\.0\.0\.3:\d+: not in 'allow' "
+                              r"\(127\.0\.0\.1\)")
+
+    def test_beyond_max_clients_a_newcomer_is_refused_and_no_one_evicted(self):
+        others = [connect_from("127.0.0.1", self.port) for _ in range(8)]
         try:
-            time.sleep(0.05)
-            # max_clients is 4: the fifth connection closes the first, which never spoke.
-            self.assertEqual(pymodbus_read(self.port, STATUS, 1), [STALE])
-            self.assertEqual(sockets[0].recv(1), b"")
-            for kept in sockets[1:]:
-                self.assertEqual(request(kept, 1, 1, struct.pack(">BHH", 3, STATUS, 1)),
-                                 struct.pack(">HHHBBBH", 1, 0, 5, 1, 3, 2, STALE))
+            for transaction, connection in enumerate(others):
+                read_block(connection, transaction)  # all eight active
+            with connect_from("127.0.0.1", self.port) as ninth:
+                self.assertLess(closed_within(ninth, 1), 0.2)
+            # Room for the PLC all the same, and the eight are still served.
+            with connect_from(PLC_HOST, self.port) as plc:
+                self.assert_the_right_distance(list(struct.unpack(">11H", read_block(plc)[9:])))
+            for transaction, connection in enumerate(others):
+                registers = struct.unpack(">11H", read_block(connection, transaction)[9:])
+                self.assert_the_right_distance(list(registers))
         finally:
-            for connection in sockets:
+            for connection in others:
                 connection.close()
+        log = self.stop()
+        self.assertRegex(log, r"refused the connection from 127\.0\.0\.1:\d+: max_clients \(8\) "
+                              r"other clients are connected")
+        self.assertNotIn("closing the one", log)
+
+    def test_malformed_frames_close_only_their_sender(self):
+        plc = PlcPoller(self.port)
+        plc.start()
+        time.sleep(0.2)
+        try:
+            for garbage in [struct.pack(">HHHBBHH", 1, 1, 6, 1, 3, 0, COUNT),  # protocol 1
+                            struct.pack(">HHHB", 1, 0, 0, 1),  # length 0
+                            struct.pack(">HHHBB", 1, 0, 1, 1, 3),  # length 1: no function
+                            struct.pack(">HHHB", 1, 0, 255, 1),  # one past the largest
+                            struct.pack(">HHHB", 1, 0, 0xFFFF, 1) + b"\0" * 100,
+                            struct.pack(">HHHBBB", 1, 0, 3, 1, 0x83, 2)]:  # a response
+                with connect_from("127.0.0.1", self.port) as sender:
+                    sender.sendall(garbage)
+                    self.assertLess(closed_within(sender, 1), 0.2, garbage)
+            with connect_from("127.0.0.1", self.port) as sender:
+                # The largest frame there is, but not a read: an exception, still connected;
+                # then two requests in one segment: two answers.
+                sender.sendall(struct.pack(">HHHBB", 5, 0, 254, 1, 3) + b"\0" * 252)
+                self.assertEqual(receive_frame(sender), exception_frame(5, 1, 3, 3))
+                read = struct.pack(">HHHBBHH", 6, 0, 6, 1, 3, STATUS, 1)
+                sender.sendall(read + read.replace(b"\0\6\0\0", b"\0\7\0\0", 1))
+                for transaction in (6, 7):
+                    self.assertEqual(receive_frame(sender)[:9],
+                                     struct.pack(">HHHBBB", transaction, 0, 5, 1, 3, 2))
+            time.sleep(0.2)
+        finally:
+            plc.stop()
+        log = self.stop()
+        self.assertGreater(len(plc.polls), 5)
+        self.assertEqual(len({local for _, _, local in plc.polls}), 1)
+        for _, registers, _ in plc.polls:
+            self.assert_the_right_distance(registers)
+        self.assertIn("sent bytes that are not Modbus TCP (protocol id 1, length 6; expected "
+                      "protocol id 0 and length 2..254); disconnected", log)
+        self.assertRegex(log, r"5 more like it in the last \d+ s; the latest: Modbus client "
+                              r"127\.0\.0\.1:\d+ sent function code 131, which is not a request")
+
+    def test_a_reconnecting_plc_replaces_its_own_quietest_connection(self):
+        with connect_from(PLC_HOST, self.port) as dead, \
+                connect_from(PLC_HOST, self.port) as polling:
+            time.sleep(0.1)
+            read_block(polling)
+            with connect_from(PLC_HOST, self.port) as again:  # plc_clients is 2
+                self.assertLess(closed_within(dead, 1), 0.2)
+                self.assert_the_right_distance(list(struct.unpack(">11H", read_block(again)[9:])))
+                self.assert_the_right_distance(
+                    list(struct.unpack(">11H", read_block(polling)[9:])))
+            dead_port = dead.getsockname()[1]
+        log = self.stop()
+        self.assertRegex(log, r"plc_clients \(2\) PLC connections open: closing the one from "
+                              r"127\.0\.0\.2:%d, quiet for \d+ ms, to accept 127\.0\.0\.2:\d+"
+                              % dead_port)
+
+    def test_a_wrong_plc_address_fails_to_start_naming_it(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            wrong = TilthRun(tmp, {"address": "127.0.0.1", "port": free_port(),
+                                   "plc_address": ["192.168.1.10", "192.168.1.0/33"]},
+                             {"frames": 1})
+            code, log = wrong.wait()
+        self.assertEqual(code, 1, log)
+        self.assertIn("node 'plc' (modbus.output) failed to start: parameter 'plc_address'/1: "
+                      "expected an IPv4 address such as 192.168.1.10 or a CIDR block such as "
+                      "192.168.1.0/24 (prefix length 0..32), got '192.168.1.0/33'", log)
 
 
 class ClientMode(unittest.TestCase):
