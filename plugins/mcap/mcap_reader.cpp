@@ -42,8 +42,8 @@ McapReader::McapReader(std::filesystem::path file) : file_(std::move(file)) {
       length > file_size_ - kMagic.size() - kRecordPrefixSize) {
     throw Error(where("Header", kMagic.size()) + ": expected a complete Header record");
   }
-  RecordParser header(read_bytes(kMagic.size() + kRecordPrefixSize, length),
-                      where("Header", kMagic.size()));
+  const std::string header_bytes = read_bytes(kMagic.size() + kRecordPrefixSize, length);
+  RecordParser header(header_bytes, where("Header", kMagic.size()));
   header.string("profile");
   library_ = header.string("library");
   data_start_ = kMagic.size() + kRecordPrefixSize + length;
