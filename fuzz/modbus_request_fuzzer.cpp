@@ -8,6 +8,7 @@
 // the same position (same transaction id and unit, same function code or the exception
 // to it).
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -35,7 +36,7 @@ using tilth::modbus::ModbusServer;
 using tilth::modbus::ServerOptions;
 
 constexpr std::size_t kMbapSize = 7;
-constexpr int kCloseTimeoutMs = 10'000;
+constexpr int kCloseTimeoutMs = 10000;
 constexpr std::size_t kMaxReplyBytes = 1 << 16;
 
 [[noreturn]] void fail(const char* what) {
@@ -109,9 +110,17 @@ std::vector<std::vector<std::uint8_t>> frames_of(const std::vector<std::uint8_t>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const Server server;
+  // The client closes first, so each connection leaves a TIME_WAIT (60 s) behind on its
+  // side: thousands a second would use up one address's ephemeral ports in seconds. The
+  // client therefore connects from the 253 loopback addresses 127.0.0.2 to 127.0.0.254
+  // in turn.
+  static std::uint32_t connections = 0;
+  sockaddr_in source = loopback(0);
+  source.sin_addr.s_addr = htonl(INADDR_LOOPBACK + 1 + connections++ % 253);
   const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   const sockaddr_in address = loopback(server.port);
-  if (fd == -1 || ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+  if (fd == -1 || ::bind(fd, reinterpret_cast<const sockaddr*>(&source), sizeof source) != 0 ||
+      ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     fail("cannot connect to the server");
   }
   // The server may close the connection before it has read everything (bytes that are
@@ -126,17 +135,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<std::uint8_t> replies;
   for (;;) {
     pollfd polled{fd, POLLIN, 0};
-    if (::poll(&polled, 1, kCloseTimeoutMs) != 1) fail("the server kept the connection open");
+    if (::poll(&polled, 1, kCloseTimeoutMs) != 1) {
+      tcp_info info{};
+      socklen_t length = sizeof info;
+      ::getsockopt(fd, IPPROTO_TCP, TCP_INFO, &info, &length);
+      std::fprintf(stderr, "modbus_request: after %zu bytes sent and %zu received, TCP state %u\n",
+                   size, replies.size(), static_cast<unsigned>(info.tcpi_state));
+      fail("the server kept the connection open");
+    }
     std::uint8_t buffer[4096];
     const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
     if (n <= 0) break;  // closed (or reset after the bytes it refused)
     replies.insert(replies.end(), buffer, buffer + n);
     if (replies.size() > kMaxReplyBytes) fail("more reply bytes than requests could ask for");
   }
-  // Without TIME_WAIT: a connection per input would otherwise use up the loopback's
-  // ephemeral ports within seconds.
-  const linger abort{1, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_LINGER, &abort, sizeof abort);
   ::close(fd);
 
   const auto requests = frames_of(std::vector<std::uint8_t>(data, data + size));
