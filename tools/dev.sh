@@ -14,6 +14,9 @@ case "$mode" in
 esac
 
 bash tools/setup.sh
+# ccache hits across clones (CI builds in a fresh one): paths taken relative to the clone,
+# and the build folder left out of the hash of objects with debug info.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 cmake --preset default >/dev/null
 cmake --build --preset default
 
