@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The two front-door commands (see README.md):
 #   bash tools/dev.sh demo   install what is missing, build, run the built-in demo graph
-#   bash tools/dev.sh test   install what is missing, build, run every test (incl. TSan)
+#   bash tools/dev.sh test   install what is missing, build, run every test, then again
+#                            under ASan+UBSan, the concurrent ones under TSan, and each
+#                            fuzz target for TILTH_FUZZ_SECONDS (default 60) seconds
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,6 +14,9 @@ case "$mode" in
 esac
 
 bash tools/setup.sh
+# ccache hits across clones (CI builds in a fresh one): paths taken relative to the clone,
+# and the build folder left out of the hash of objects with debug info.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=true
 cmake --preset default >/dev/null
 cmake --build --preset default
 
@@ -20,8 +25,23 @@ if [ "$mode" = demo ]; then
   exec build/bin/tilth run graphs/demo.json --frames 100 "$@"
 fi
 
-ctest --preset default
-# The concurrency tests again under ThreadSanitizer.
+# Each step's duration, for the CI log (docs/reliability.md keeps the figures).
+step() {
+  local start=$SECONDS
+  "$@"
+  echo "dev.sh: '$*' took $((SECONDS - start)) s"
+}
+
+step ctest --preset default
+# Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
+cmake --preset asan >/dev/null
+step cmake --build --preset asan
+step ctest --preset asan
+# The concurrency tests and the stages that run frames in parallel under ThreadSanitizer.
 cmake --preset tsan >/dev/null
-cmake --build --preset tsan
-ctest --preset tsan
+step cmake --build --preset tsan
+step ctest --preset tsan
+# The readers under libFuzzer; a crash fails the run.
+cmake --preset fuzz >/dev/null
+step cmake --build --preset fuzz
+bash fuzz/run.sh "${TILTH_FUZZ_SECONDS:-60}"

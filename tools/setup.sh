@@ -17,6 +17,8 @@ packages=(
   libzstd-dev liblz4-dev nodejs
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
+  # the fuzz targets: clang with libFuzzer and its sanitizer runtimes
+  clang libclang-rt-14-dev
   # independent readers in tests
   python3-opencv python3-numpy
   # tilth ab tests: statistics recomputed independently, the report opened in a browser
