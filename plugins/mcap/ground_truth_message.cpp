@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::mcap {
 namespace {
@@ -48,10 +49,8 @@ std::string encode_ground_truth(std::optional<double> distance_mm, bool has_mask
 }
 
 GroundTruthMessage decode_ground_truth(std::string_view text, const std::string& where) {
-  const json message = json::parse(text, nullptr, false);
-  if (message.is_discarded() || !message.is_object()) {
-    throw Error(where + ": message data is not a JSON object");
-  }
+  const json message = parse_json(text, where);
+  if (!message.is_object()) throw Error(where + ": message data is not a JSON object");
   try {
     GroundTruthMessage truth;
     const json& distance = message.at("distance_mm");

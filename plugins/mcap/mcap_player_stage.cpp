@@ -27,6 +27,7 @@
 #include "recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -67,9 +68,7 @@ RigCalibration read_calibration(McapReader& reader) {
                 std::string(kCalibrationAttachment) + " (the rig calibration mcap.writer stores)");
   }
   const std::string origin = reader.file().string() + ":" + attachment->name;
-  const nlohmann::json document = nlohmann::json::parse(attachment->data, nullptr, false);
-  if (document.is_discarded()) throw Error(origin + ": not valid JSON");
-  return parse_calibration(document, origin);
+  return parse_calibration(parse_json(attachment->data, origin), origin);
 }
 
 class McapPlayer final : public Source {

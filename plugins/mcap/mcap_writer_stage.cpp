@@ -17,10 +17,8 @@
 // is its device time.
 #include <chrono>
 #include <deque>
-#include <fstream>
 #include <functional>
 #include <limits>
-#include <sstream>
 
 #include "ground_truth_message.h"
 #include "mcap_writer.h"
@@ -28,6 +26,7 @@
 #include "recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
+#include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -41,14 +40,6 @@ namespace fs = std::filesystem;
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
-
-std::string read_file(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(file.string() + ": cannot read");
-  return text.str();
-}
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -95,9 +86,10 @@ WriterOptions writer_options(const Params& params) {
 class McapWriterStage final : public Sink {
  public:
   explicit McapWriterStage(const StageContext& context)
-      : calibration_text_(read_file(context.params.path("calibration"))),
-        calibration_(parse_calibration(nlohmann::json::parse(calibration_text_, nullptr, false),
-                                       context.params.path("calibration").string())),
+      : calibration_text_(read_json_text(context.params.path("calibration"), "calibration file")),
+        calibration_(parse_calibration(
+            parse_json(calibration_text_, context.params.path("calibration").string()),
+            context.params.path("calibration").string())),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
         color_size_(calibration_.color.width, calibration_.color.height),
         writer_(context.params.path("path"), writer_options(context.params)),
@@ -112,8 +104,8 @@ class McapWriterStage final : public Sink {
     std::map<std::string, std::string> recording{{"node", context.node},
                                                  {"log_time", context.params.string("log_time")}};
     if (!graph.empty()) {
-      writer_.add_attachment(
-          {created, created, graph.filename().string(), "application/json", read_file(graph)});
+      writer_.add_attachment({created, created, graph.filename().string(), "application/json",
+                              read_json_text(graph, "graph file")});
       recording["graph_file"] = graph.filename().string();
     }
     writer_.add_metadata({std::string(kRecordingMetadata), recording});

@@ -17,6 +17,7 @@
 #include "host_timestamps_csv.h"
 #include "pixel_checks.h"
 #include "recording_json.h"
+#include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -62,14 +63,6 @@ void check_folder(const fs::path& folder, bool overwrite) {
   }
 }
 
-std::string read_file(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(file.string() + ": cannot read");
-  return text.str();
-}
-
 struct StoredColor {
   PixelFormat format;
   cv::Mat pixels;
@@ -106,7 +99,7 @@ class ImageFolderWriter final : public Sink {
       : folder_(context.params.path("path")),
         calibration_(load_calibration(context.params.path("calibration"))),
         // Kept, not copied later: the file may be in the folder that overwrite replaces.
-        calibration_text_(read_file(context.params.path("calibration"))),
+        calibration_text_(read_json_text(context.params.path("calibration"), "calibration file")),
         description_(context.params.string("description")),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
         color_size_(calibration_.color.width, calibration_.color.height) {

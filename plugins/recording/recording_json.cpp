@@ -40,10 +40,7 @@ RigCalibration read_calibration(const json& value, const fs::path& folder, const
     fail(file, "/calibration",
          "a calibration file name relative to the folder, or a calibration object", value);
   }
-  const fs::path calibration = folder / value.get<std::string>();
-  return parse_calibration(
-      parse_json(read_json_text(calibration, "calibration file"), calibration.string()),
-      calibration.string());
+  return load_calibration(folder / value.get<std::string>());
 }
 
 }  // namespace
@@ -65,8 +62,8 @@ std::string recording_color_formats() {
 
 RecordingJson read_recording_json(const fs::path& folder) {
   const fs::path file = folder / "recording.json";
-  const json document =
-      parse_json(read_json_text(file, "(is this a recording folder?)"), file.string());
+  if (!fs::exists(file)) throw Error(file.string() + ": cannot read (is this a recording folder?)");
+  const json document = parse_json(read_json_text(file, "recording.json"), file.string());
   if (!document.is_object()) fail(file, "", "an object", document);
   for (const auto& [key, value] : document.items()) {
     if (key != "format" && key != "calibration" && key != "color_format" && key != "description") {

@@ -1,9 +1,10 @@
 #include "tilth/json_input.h"
 
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <vector>
+
+#include "tilth/regular_file.h"
 
 namespace tilth {
 namespace {
@@ -169,24 +170,6 @@ Json parse(std::string_view text, const std::string& origin, JsonSyntax syntax) 
   return builder.take();
 }
 
-std::string file_kind(std::filesystem::file_type type) {
-  using std::filesystem::file_type;
-  switch (type) {
-    case file_type::directory:
-      return "a folder";
-    case file_type::character:
-      return "a character device";
-    case file_type::block:
-      return "a block device";
-    case file_type::fifo:
-      return "a FIFO";
-    case file_type::socket:
-      return "a socket";
-    default:
-      return "not a regular file";
-  }
-}
-
 }  // namespace
 
 JsonError::JsonError(std::string origin, std::string pointer, int line, int column,
@@ -213,36 +196,19 @@ nlohmann::ordered_json parse_ordered_json(std::string_view text, const std::stri
 
 std::string read_json_text(const std::filesystem::path& file, std::string_view what) {
   const std::string name = file.string();
-  const std::string cannot = "cannot read " + std::string(what);
   std::error_code error;
-  const auto status = std::filesystem::status(file, error);
-  if (error || status.type() == std::filesystem::file_type::not_found) {
-    throw JsonError(name, "", 0, 0, cannot);
+  if (!std::filesystem::exists(file, error)) {
+    throw JsonError(name, "", 0, 0, "cannot read " + std::string(what));
   }
-  if (status.type() != std::filesystem::file_type::regular) {
-    throw JsonError(name, "", 0, 0,
-                    cannot + ": expected a regular file, got " + file_kind(status.type()));
+  try {
+    return read_regular_file(file, kMaxJsonFileBytes, what);
+  } catch (const Error& refused) {
+    // "NAME: REASON" as a JsonError, so that readers that collect problems keep its parts.
+    const std::string_view text = refused.what();
+    const std::string_view reason =
+        text.starts_with(name + ": ") ? text.substr(name.size() + 2) : text;
+    throw JsonError(name, "", 0, 0, std::string(reason));
   }
-  const auto too_large = [&](const std::string& size) {
-    return JsonError(name, "", 0, 0,
-                     cannot + ": expected at most " + std::to_string(kMaxJsonFileBytes >> 20) +
-                         " MiB, got " + size);
-  };
-  if (const auto size = std::filesystem::file_size(file, error);
-      !error && size > kMaxJsonFileBytes) {
-    throw too_large(std::to_string(size) + " bytes");
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw JsonError(name, "", 0, 0, cannot);
-  // Counted as read too: the file may have grown since.
-  std::string text;
-  char chunk[65536];
-  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
-    text.append(chunk, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxJsonFileBytes) throw too_large("more");
-  }
-  if (in.bad()) throw JsonError(name, "", 0, 0, cannot);
-  return text;
 }
 
 }  // namespace tilth

@@ -116,10 +116,10 @@ class UntrustedInput(unittest.TestCase):
                 f.write('{"include": ["/dev/zero", "fifo.json"]}')
             result = tilth("validate", path, timeout=20)
         self.assertEqual(result.returncode, 2, result.stderr)
-        self.assertIn(path + ":/include/0/file: cannot read graph file '/dev/zero': expected a "
-                      "regular file, got a character device", result.stderr)
-        self.assertIn(path + ":/include/1/file: cannot read graph file '" + fifo + "': expected a "
-                      "regular file, got a FIFO", result.stderr)
+        self.assertIn(path + ":/include/0/file: is a character device; expected a regular file "
+                      "(graph file '/dev/zero')", result.stderr)
+        self.assertIn(path + ":/include/1/file: is a FIFO; expected a regular file (graph file '" +
+                      fifo + "')", result.stderr)
 
 
 class Run(unittest.TestCase):

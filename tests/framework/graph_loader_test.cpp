@@ -260,8 +260,8 @@ TEST(GraphLoader, IncludeOfADeviceIsRefused) {
   TempDir dir;
   const auto file = dir.write("g.json", R"({"include": ["/dev/zero"]})");
   EXPECT_EQ(load_error(file), file.string() +
-                                  ":/include/0/file: cannot read graph file '/dev/zero': expected "
-                                  "a regular file, got a character device");
+                                  ":/include/0/file: is a character device; expected a regular "
+                                  "file (graph file '/dev/zero')");
 }
 
 }  // namespace

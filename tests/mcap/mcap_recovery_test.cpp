@@ -308,24 +308,28 @@ TEST_F(McapRecoveryTest, InfoChecksTheDataSectionCrc) {
       << info.problems[0];
 }
 
-// A stop signal during `tilth recording repair FILE`: FILE is left as it was, and no
-// partial output remains.
-TEST_F(McapRecoveryTest, StoppedRepairLeavesTheFileAsItWas) {
+// A stop signal during `tilth recording repair FILE OUTPUT`: FILE and an existing OUTPUT
+// are left as they were, and no partial output remains.
+TEST_F(McapRecoveryTest, StoppedRepairLeavesTheFilesAsTheyWere) {
   const fs::path file = dir_.path() / "cut.mcap";
+  const fs::path output = dir_.path() / "repaired.mcap";
   copy_prefix(complete_, file, chunks_[3].chunk_start_offset + 100);
+  copy_prefix(complete_, output, chunks_[1].chunk_start_offset);
   const std::string before = read_text(file);
+  const std::string output_before = read_text(output);
   int asked = 0;
   try {
-    mcap::repair_recording(file, file, [&asked] { return ++asked == 2; });
+    mcap::repair_recording(file, output, [&asked] { return ++asked == 2; });
     FAIL() << "a stopped repair returned";
   } catch (const Error& error) {
     EXPECT_EQ(std::string(error.what()), "repairing " + file.string() +
                                              ": stopped before the repair was complete; " +
-                                             file.string() + " is left as it was");
+                                             output.string() + " is left as it was");
   }
   EXPECT_EQ(asked, 2);  // once per chunk, until it said stop
   EXPECT_EQ(read_text(file), before);
-  EXPECT_FALSE(fs::exists(file.string() + ".repairing"));
+  EXPECT_EQ(read_text(output), output_before);
+  EXPECT_FALSE(fs::exists(output.string() + ".repairing"));
 }
 
 TEST_F(McapRecoveryTest, CorruptChunkIsReportedWithItsOffset) {

@@ -581,7 +581,7 @@ class Connections(unittest.TestCase):
                 connect_from(PLC_HOST, self.port) as plc:
             slow.sendall(b"\0")  # a request's first bytes, one at a time
             time.sleep(0.5)
-            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(quiet)[9:])))
+            self.assert_the_right_distance(list(struct.unpack(">%dH" % COUNT, read_block(quiet)[9:])))
             for _ in range(3):
                 time.sleep(0.1)
                 slow.sendall(b"\0")
@@ -599,7 +599,7 @@ class Connections(unittest.TestCase):
             self.assertIsNone(closed_within(plc, 0.6))
             self.assertGreater(time.monotonic() - start, 2 * timeout)
             plc.settimeout(2)
-            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(plc)[9:])))
+            self.assert_the_right_distance(list(struct.unpack(">%dH" % COUNT, read_block(plc)[9:])))
         log = self.stop()
         self.assertRegex(log, r"Modbus client 127\.0\.0\.1:\d+ closed: no request for 1\d\d\d ms "
                               r"\(idle_timeout_ms 1000\)")
@@ -609,7 +609,7 @@ class Connections(unittest.TestCase):
             outsider.sendall(struct.pack(">HHHBBHH", 1, 0, 6, 1, 3, 0, COUNT))
             self.assertLess(closed_within(outsider, 1), 0.2)
         with connect_from("127.0.0.1", self.port) as allowed:
-            self.assert_the_right_distance(list(struct.unpack(">11H", read_block(allowed)[9:])))
+            self.assert_the_right_distance(list(struct.unpack(">%dH" % COUNT, read_block(allowed)[9:])))
         log = self.stop()
         self.assertRegex(log, r"refused the connection from 127\.0\.0\.3:\d+: not in 'allow' "
                               r"\(127\.0\.0\.1\)")
@@ -623,9 +623,9 @@ class Connections(unittest.TestCase):
                 self.assertLess(closed_within(ninth, 1), 0.2)
             # Room for the PLC all the same, and the eight are still served.
             with connect_from(PLC_HOST, self.port) as plc:
-                self.assert_the_right_distance(list(struct.unpack(">11H", read_block(plc)[9:])))
+                self.assert_the_right_distance(list(struct.unpack(">%dH" % COUNT, read_block(plc)[9:])))
             for transaction, connection in enumerate(others):
-                registers = struct.unpack(">11H", read_block(connection, transaction)[9:])
+                registers = struct.unpack(">%dH" % COUNT, read_block(connection, transaction)[9:])
                 self.assert_the_right_distance(list(registers))
         finally:
             for connection in others:
@@ -679,9 +679,9 @@ class Connections(unittest.TestCase):
             read_block(polling)
             with connect_from(PLC_HOST, self.port) as again:  # plc_clients is 2
                 self.assertLess(closed_within(dead, 1), 0.2)
-                self.assert_the_right_distance(list(struct.unpack(">11H", read_block(again)[9:])))
+                self.assert_the_right_distance(list(struct.unpack(">%dH" % COUNT, read_block(again)[9:])))
                 self.assert_the_right_distance(
-                    list(struct.unpack(">11H", read_block(polling)[9:])))
+                    list(struct.unpack(">%dH" % COUNT, read_block(polling)[9:])))
             dead_port = dead.getsockname()[1]
         log = self.stop()
         self.assertRegex(log, r"plc_clients \(2\) PLC connections open: closing the one from "

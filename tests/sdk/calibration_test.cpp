@@ -229,8 +229,7 @@ TEST(Calibration, FileBeyondWhatJsonReadersTakeIsRefused) {
                                       "range (magnitude below 1.8e308), got 1e400");
 
   EXPECT_EQ(load_error("/dev/zero"),
-            "/dev/zero: cannot read calibration file: expected a regular file, got a character "
-            "device");
+            "/dev/zero: is a character device; expected a regular file (calibration file)");
 }
 
 }  // namespace

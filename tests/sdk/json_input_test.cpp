@@ -102,24 +102,22 @@ TEST(JsonInput, OnlySmallRegularFilesAreRead) {
   EXPECT_EQ(read_json_text(file, "test file"), "{}");
 
   EXPECT_EQ(read_failure("/dev/zero"),
-            "/dev/zero: cannot read test file: expected a regular file, got a character device");
-  EXPECT_EQ(read_failure(dir.path()), dir.path().string() +
-                                          ": cannot read test file: expected a regular file, got "
-                                          "a folder");
+            "/dev/zero: is a character device; expected a regular file (test file)");
+  EXPECT_EQ(read_failure(dir.path()),
+            dir.path().string() + ": is a folder; expected a regular file (test file)");
   // Opening a FIFO for reading would wait for a writer forever.
   const auto fifo = dir.path() / "fifo.json";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(read_failure(fifo),
-            fifo.string() + ": cannot read test file: expected a regular file, got a FIFO");
+  EXPECT_EQ(read_failure(fifo), fifo.string() + ": is a FIFO; expected a regular file (test file)");
   EXPECT_EQ(read_failure(dir.path() / "none.json"),
             (dir.path() / "none.json").string() + ": cannot read test file");
 
   // Sparse: 17 MiB long, no disk used.
   const auto large = dir.write("large.json", "");
   std::filesystem::resize_file(large, kMaxJsonFileBytes + 1);
-  EXPECT_EQ(read_failure(large), large.string() +
-                                     ": cannot read test file: expected at most 16 MiB, got " +
-                                     std::to_string(kMaxJsonFileBytes + 1) + " bytes");
+  EXPECT_EQ(read_failure(large), large.string() + ": is " + std::to_string(kMaxJsonFileBytes + 1) +
+                                     " bytes; expected at most " +
+                                     std::to_string(kMaxJsonFileBytes) + " for a test file");
   std::filesystem::resize_file(large, kMaxJsonFileBytes);
   EXPECT_EQ(read_json_text(large, "test file").size(), kMaxJsonFileBytes);
 }

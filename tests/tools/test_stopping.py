@@ -18,7 +18,7 @@ SOURCE = os.environ["TILTH_SOURCE_DIR"]
 PLUGIN_PATH = os.environ["TILTH_TEST_PLUGIN_PATH"]
 PRELOAD = os.environ["EARLY_THREAD_PRELOAD"]
 
-CSV_FIELDS = 11
+CSV_FIELDS = 12
 SECOND_SIGNAL = "second stop signal: exiting at once (code 130)"
 LIBC = ctypes.CDLL(None, use_errno=True)
 

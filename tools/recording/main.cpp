@@ -81,18 +81,17 @@ int repair(const CommandLine& line) {
   if (args.size() != 3 || line.value("--compression")) {
     return usage_error("repair takes FILE OUTPUT [--overwrite]");
   }
---overwrite replaces only a recording (an MCAP file, a folder with recording.json),
-and no output may be, hold or lie inside its input.
-
-SIGINT or SIGTERM stops export and import cleanly: the frames converted so far are
-written and the output closed (an MCAP file with its summary), exit code 0; it stops a
-repair, which then removes its partial output and leaves FILE as it was (exit code 1).
-A second signal exits at once (code 130).
-
-Exit code 0 on success, 1 when the recording cannot be read or written, 2 for bad
-usage, 3 when info finds damage, repair had to leave data out (both say what), or a
-conversion's writer could not store every frame (a full disk; the output holds the
-frames before it).
+  const fs::path input = args[1];
+  const fs::path output = args[2];
+  tilth::tools::check_apart(input, output);
+  tilth::tools::check_output_path(output, tilth::tools::RecordingKind::kMcapFile,
+                                  line.flag("--overwrite"));
+  std::atomic<bool> stopped{false};
+  const auto result = [&] {
+    const tilth::tools::StopSignalWatcher watcher("tilth recording",
+                                                  [&stopped] { stopped = true; });
+    return tilth::mcap::repair_recording(input, output, [&stopped] { return stopped.load(); });
+  }();
   std::cout << output.string() << ": " << result.messages << " messages in " << result.chunks
             << " chunks, with a summary\n";
   if (result.dropped.empty()) return kExitOk;
