@@ -35,47 +35,14 @@ import time
 
 SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "modbus"))
+sys.path.insert(0, os.path.join(SOURCE, "tests", "support"))
+from fake_gige_camera import FakeCamera  # noqa: E402
 from pymodbus_tcp import ModbusTcpClient  # noqa: E402
-
-GVCP_PORT = 3956
-
 
 def free_port():
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
-
-
-def udp_bound(address, port):
-    import struct
-    wanted = "%08X:%04X" % (struct.unpack("<I", socket.inet_aton(address))[0], port)
-    with open("/proc/net/udp") as table:
-        return any(wanted in line for line in table)
-
-
-class FakeCamera:
-    def __init__(self, address, serial):
-        self.address, self.serial, self.process = address, serial, None
-        shown = subprocess.run(["ip", "-o", "addr", "show", "dev", "lo"], capture_output=True,
-                               text=True, check=True).stdout
-        if " inet %s/" % address not in shown:
-            subprocess.run(["ip", "addr", "add", address + "/8", "dev", "lo"], check=True)
-
-    def start(self):
-        self.process = subprocess.Popen(
-            ["arv-fake-gv-camera-0.8", "-i", self.address, "-s", self.serial],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 10
-        while not udp_bound(self.address, GVCP_PORT):
-            if time.monotonic() > deadline:
-                raise RuntimeError("the camera simulator did not start on " + self.address)
-            time.sleep(0.02)
-
-    def kill(self):
-        if self.process is not None:
-            self.process.kill()
-            self.process.wait()
-            self.process = None
 
 
 def proc_figures(pid):

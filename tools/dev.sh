@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # The two front-door commands (see README.md):
 #   bash tools/dev.sh demo   install what is missing, build, run the built-in demo graph
-#   bash tools/dev.sh test   install what is missing, build, run every test, then again
-#                            under ASan+UBSan, the concurrent ones under TSan, and each
-#                            fuzz target for TILTH_FUZZ_SECONDS (default 60) seconds
+#   bash tools/dev.sh test   install what is missing, build, run every test, the
+#                            concurrent ones under TSan, and each fuzz target for
+#                            TILTH_FUZZ_SECONDS (default 60) seconds
+#   bash tools/dev.sh sanitize   every test again under ASan+UBSan (docs/reliability.md)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-}
 case "$mode" in
-  demo|test) ;;
-  *) echo "usage: bash tools/dev.sh demo|test" >&2; exit 2 ;;
+  demo|test|sanitize) ;;
+  *) echo "usage: bash tools/dev.sh demo|test|sanitize" >&2; exit 2 ;;
 esac
 
 bash tools/setup.sh
@@ -32,12 +33,16 @@ step() {
   echo "dev.sh: '$*' took $((SECONDS - start)) s"
 }
 
+if [ "$mode" = sanitize ]; then
+  # Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
+  cmake --preset asan >/dev/null
+  step cmake --build --preset asan
+  step ctest --preset asan
+  exit 0
+fi
+
 step ctest --preset default
-# Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
-cmake --preset asan >/dev/null
-step cmake --build --preset asan
-step ctest --preset asan
-# The concurrency tests and the stages that run frames in parallel under ThreadSanitizer.
+# The concurrency tests under ThreadSanitizer.
 cmake --preset tsan >/dev/null
 step cmake --build --preset tsan
 step ctest --preset tsan

@@ -13,51 +13,20 @@ import csv
 import json
 import os
 import signal
-import socket
 import statistics
-import struct
 import subprocess
+import sys
 import tempfile
 import threading
 import time
 import unittest
 
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from fake_gige_camera import FakeCamera  # noqa: E402
+
 TILTH = os.environ["TILTH_BIN"]
 TEST_PLUGINS = os.environ["TILTH_TEST_PLUGIN_DIR"]
-GVCP_PORT = 3956
-
-
-def udp_bound(address, port):
-    wanted = "%08X:%04X" % (struct.unpack("<I", socket.inet_aton(address))[0], port)
-    with open("/proc/net/udp") as table:
-        return any(wanted in line for line in table)
-
-
-class FakeCamera:
-    def __init__(self, address, serial):
-        self.address, self.serial, self.process = address, serial, None
-        shown = subprocess.run(["ip", "-o", "addr", "show", "dev", "lo"], capture_output=True,
-                               text=True, check=True).stdout
-        if " inet %s/" % address not in shown:
-            subprocess.run(["ip", "addr", "add", address + "/8", "dev", "lo"], check=True)
-
-    def start(self):
-        assert not udp_bound(self.address, GVCP_PORT), "a device already listens on " + self.address
-        # At a higher priority than the tests: the simulator plays a camera, which has a
-        # processor of its own.
-        self.process = subprocess.Popen(
-            ["nice", "-n", "-10", "arv-fake-gv-camera-0.8", "-i", self.address, "-s", self.serial],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 5
-        while not udp_bound(self.address, GVCP_PORT):
-            assert time.monotonic() < deadline, "the simulator did not start on " + self.address
-            time.sleep(0.01)
-
-    def kill(self):
-        if self.process:
-            self.process.kill()
-            self.process.wait()
-            self.process = None
 
 
 DEPTH = FakeCamera("127.0.0.21", "TILTH21")

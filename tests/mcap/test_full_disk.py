@@ -9,8 +9,13 @@ import re
 import resource
 import signal
 import subprocess
+import sys
 import tempfile
 import unittest
+
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from rigs import quarter_rig  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
@@ -18,21 +23,6 @@ PLUGIN_DIR = os.environ["TILTH_TEST_PLUGIN_DIR"]
 
 FRAMES = 40
 LIMIT = 3_000_000  # bytes: about ten frames of the quarter rig, uncompressed
-
-
-def quarter_rig(folder):
-    """The paper's rig at a quarter of its resolution: fast to simulate, same views."""
-    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
-        rig = json.load(f)
-    for camera in (rig["depth_camera"], rig["color_camera"]):
-        camera["width"] //= 4
-        camera["height"] //= 4
-        for key in ("fx", "fy", "cx", "cy"):
-            camera[key] /= 4
-    path = os.path.join(folder, "quarter.calib.json")
-    with open(path, "w") as f:
-        json.dump(rig, f, indent=2)
-    return path
 
 
 def limit_file_size():

@@ -7,6 +7,7 @@ import json
 import os
 import re
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -16,6 +17,10 @@ import numpy as np
 from check_folder import PNG_GRAY, PNG_RGB, make_frames, read_png, small_calibration, \
     write_input_recording
 
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from rigs import quarter_rig  # noqa: E402
+
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -24,21 +29,6 @@ MCAP_MAGIC = b"\x89MCAP0\r\n"
 def tilth(*args, timeout=120):
     return subprocess.run([TILTH, *map(str, args)], capture_output=True, text=True,
                           timeout=timeout)
-
-
-def quarter_rig(folder):
-    """The paper's rig at a quarter of its resolution: fast to simulate, same views."""
-    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
-        rig = json.load(f)
-    for camera in (rig["depth_camera"], rig["color_camera"]):
-        camera["width"] //= 4
-        camera["height"] //= 4
-        for key in ("fx", "fy", "cx", "cy"):
-            camera[key] /= 4
-    path = os.path.join(folder, "quarter.calib.json")
-    with open(path, "w") as f:
-        json.dump(rig, f, indent=2)
-    return path
 
 
 def frames_csv(folder):

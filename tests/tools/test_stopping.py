@@ -9,9 +9,14 @@ import os
 import re
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
+
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from rigs import quarter_rig  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
@@ -104,21 +109,6 @@ def whole_csv_rows(test, path):
         test.assertEqual(int(fields[0]), i)
         float(fields[3]), float(fields[9])  # noqa: B018 (parses)
     return len(lines) - 1
-
-
-def quarter_rig(folder):
-    """The paper's rig at a quarter of its resolution: fast to simulate, same views."""
-    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
-        rig = json.load(f)
-    for camera in (rig["depth_camera"], rig["color_camera"]):
-        camera["width"] //= 4
-        camera["height"] //= 4
-        for key in ("fx", "fy", "cx", "cy"):
-            camera[key] /= 4
-    path = os.path.join(folder, "quarter.calib.json")
-    with open(path, "w") as f:
-        json.dump(rig, f, indent=2)
-    return path
 
 
 def mcap_info(test, path):
