@@ -128,7 +128,8 @@ class Chain {
       process(segment_, segment_in_, segmented_);
     }
     if (step == kEstimate || step == kWhole) {
-      process(estimate_, std::span(&segmented_[1], 1), distance_);
+      estimate_in_ = {segmented_[1], registered_[0]};  // the soil depth, and the colour checked
+      process(estimate_, estimate_in_, distance_);
       benchmark::DoNotOptimize(distance_[0].message().get());
     }
     // A stage's outputs (every message, for the whole chain) go back to its pool before
@@ -140,7 +141,8 @@ class Chain {
       for (const std::span<Packet> packets :
            {std::span<Packet>(depth_), std::span<Packet>(register_in_),
             std::span<Packet>(registered_), std::span<Packet>(segment_in_),
-            std::span<Packet>(segmented_), std::span<Packet>(distance_)}) {
+            std::span<Packet>(segmented_), std::span<Packet>(estimate_in_),
+            std::span<Packet>(distance_)}) {
         release(packets);
       }
     } else if (step == kEstimate) {
@@ -159,6 +161,7 @@ class Chain {
   std::array<Packet, 1> registered_;
   std::array<Packet, 2> segment_in_;
   std::array<Packet, 2> segmented_;
+  std::array<Packet, 2> estimate_in_;
   std::array<Packet, 1> distance_;
 };
 
