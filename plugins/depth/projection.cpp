@@ -1,4 +1,4 @@
-// depth.projection, per spec/calibration.md (paper eq. 1 for a radial measurement):
+// depth.projection, per docs/formats/calibration.md (paper eq. 1 for a radial measurement):
 //   d = g * gray_to_mm + gray_offset_mm      (the camera's own scale/offset win)
 //   z = d * factor(u, v) - z_offset_mm       factor = 1 / sqrt(x'^2 + y'^2 + 1) (radial)
 //                                            factor = 1                       (z)

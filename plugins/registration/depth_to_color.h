@@ -1,5 +1,5 @@
 // Where each depth pixel is seen in the colour image: the full projective mapping of
-// spec/calibration.md with both cameras' lens distortion. The undistorted coordinates of
+// docs/formats/calibration.md with both cameras' lens distortion. The undistorted coordinates of
 // the depth pixels are computed once per calibration; a frame costs a few multiply-adds
 // and one division per pixel, in the widest vectors the CPU has (row_kernels.h).
 #pragma once

@@ -22,7 +22,7 @@ namespace tilth::registration {
 // of this many pixels.
 inline constexpr int kRowLanes = 16;
 
-// The mapping of spec/calibration.md as the kernels read it (see DepthToColor).
+// The mapping of docs/formats/calibration.md as the kernels read it (see DepthToColor).
 struct ProjectionModel {
   int depth_width;
   int row_capacity;  // depth_width rounded up to whole vectors

@@ -1,4 +1,4 @@
-// depth.projection against eq. 1 of the paper and spec/calibration.md, with the
+// depth.projection against eq. 1 of the paper and docs/formats/calibration.md, with the
 // expected values computed here in long double from the formulas, never by the stage.
 //
 // Tolerance kMm = 1e-3 mm unless noted: the stage works in float32, whose spacing at

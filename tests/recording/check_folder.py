@@ -2,7 +2,7 @@
 
 The test writes a recording with its own code, copies it with the graph
 recording.image_folder (host_time: recorded) -> recording.image_folder_writer, and
-checks the copy against spec/recording-folder.md and the input: recording.json, the
+checks the copy against docs/formats/recording-folder.md and the input: recording.json, the
 frames.csv columns, each PNG's bit depth and colour type (read from its header), and
 every pixel, decoded once by the small PNG decoder below (no OpenCV involved) and once
 by OpenCV; and Tilth's extension host_timestamps.csv: the input's host times, or without

@@ -1,4 +1,4 @@
-// The tests' own rig geometry in long double, written from spec/calibration.md without
+// The tests' own rig geometry in long double, written from docs/formats/calibration.md without
 // the plugin's code: what the registration must agree with.
 #pragma once
 
