@@ -1,24 +1,8 @@
 #include "framework/diagnostics.h"
 
+#include "tilth/json_input.h"
+
 namespace tilth {
-namespace {
-
-// RFC 6901: '~' and '/' inside a key are escaped.
-std::string escape_pointer_token(const std::string& key) {
-  std::string escaped;
-  for (char c : key) {
-    if (c == '~') {
-      escaped += "~0";
-    } else if (c == '/') {
-      escaped += "~1";
-    } else {
-      escaped += c;
-    }
-  }
-  return escaped;
-}
-
-}  // namespace
 
 std::string Location::text() const {
   if (line > 0) return file + ":" + std::to_string(line) + ":" + std::to_string(column);
@@ -28,7 +12,7 @@ std::string Location::text() const {
 
 Location Location::child(const std::string& key) const {
   Location nested = *this;
-  nested.pointer += "/" + escape_pointer_token(key);
+  nested.pointer += "/" + json_pointer_token(key);
   return nested;
 }
 

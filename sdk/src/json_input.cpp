@@ -9,21 +9,6 @@
 namespace tilth {
 namespace {
 
-// RFC 6901: '~' and '/' inside a key are escaped.
-std::string pointer_token(const std::string& key) {
-  std::string escaped;
-  for (char c : key) {
-    if (c == '~') {
-      escaped += "~0";
-    } else if (c == '/') {
-      escaped += "~1";
-    } else {
-      escaped += c;
-    }
-  }
-  return escaped;
-}
-
 std::pair<int, int> line_and_column(std::string_view text, std::size_t byte) {
   int line = 1;
   int column = 1;
@@ -110,7 +95,7 @@ class Builder {
       const Frame& frame = frames_[i];
       const bool innermost = i + 1 == frames_.size();
       text += "/" + (frame.array ? std::to_string(frame.container->size() - (innermost ? 0 : 1))
-                                 : pointer_token(frame.key));
+                                 : json_pointer_token(frame.key));
     }
     return text;
   }
@@ -171,6 +156,20 @@ Json parse(std::string_view text, const std::string& origin, JsonSyntax syntax) 
 }
 
 }  // namespace
+
+std::string json_pointer_token(const std::string& key) {
+  std::string escaped;
+  for (char c : key) {
+    if (c == '~') {
+      escaped += "~0";
+    } else if (c == '/') {
+      escaped += "~1";
+    } else {
+      escaped += c;
+    }
+  }
+  return escaped;
+}
 
 JsonError::JsonError(std::string origin, std::string pointer, int line, int column,
                      std::string reason)

@@ -53,6 +53,9 @@ nlohmann::json parse_json(std::string_view text, const std::string& origin, Json
 nlohmann::ordered_json parse_ordered_json(std::string_view text, const std::string& origin,
                                           JsonSyntax syntax = {});
 
+// `key` as one token of a JSON pointer (RFC 6901: '~' and '/' escaped as ~0 and ~1).
+std::string json_pointer_token(const std::string& key);
+
 // The text of a JSON file: a regular file (never a device or a FIFO, which could block or
 // never end) of at most kMaxJsonFileBytes. `what` names the file's kind in the error:
 // "rig.calib.json: cannot read calibration file".
