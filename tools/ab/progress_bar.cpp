@@ -23,9 +23,15 @@ ProgressBar::~ProgressBar() {
 void ProgressBar::loop() {
   std::unique_lock lock(mutex_);
   while (!done_) {
+    const JobProgress progress = progress_();
+    // Nothing to show until the pool has its jobs: soon after it starts.
+    if (progress.jobs_total == 0) {
+      wake_.wait_for(lock, std::chrono::milliseconds(5));
+      continue;
+    }
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::fputs(("\r" + progress_text(progress_(), elapsed) + "\033[K").c_str(), stdout);
+    std::fputs(("\r" + progress_text(progress, elapsed) + "\033[K").c_str(), stdout);
     std::fflush(stdout);
     wake_.wait_for(lock, std::chrono::milliseconds(200));
   }
