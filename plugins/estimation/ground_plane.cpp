@@ -1,21 +1,32 @@
-// estimation.ground_plane: a plane fitted to the soil points of a region of interest, read
-// at the tool's position, with the ground's tilt.
+// estimation.ground_plane: the ground under the tool -- a plane fitted to the soil points
+// around the tool's position, read there, with the ground's tilt.
 //
-//   soil_depth ──► enough soil? ──► sampled rays (x', y') with depth Z ──► RANSAC (3-point
-//   planes, fixed seed) ──► least squares on the inliers, re-selected until stable ──►
-//   distance at tool_point, tilt, spread = RMS of the inlier residuals
+//   soil_depth ──► enough soil? ──► sampled rays (x', y') with depth Z, weighted by their
+//   nearness to the tool point ──► up to max_surfaces pieces of ground, each RANSAC
+//   (3-point planes, fixed seed, weighted) then least squares on its inliers, re-selected
+//   until stable, on what the earlier pieces left ──► the piece the tool stands on ──►
+//   distance at tool_point, tilt, spread = weighted RMS of the inlier residuals
 //
 // The plane is written a X + b Y + c Z = 1 in the ToF camera frame (origin at the optical
 // centre), so along the ray of undistorted normalised coordinates (x', y') it lies at
 // Z = 1 / (a x' + b y' + c): 1/Z is linear in (x', y'), which come from the calibration
 // and carry no noise. Residuals are along Z, in mm.
 //
-// Tilts are slope angles: tilt_x_deg = atan(dZ/dY) (the ground turned about the camera's
-// x axis; positive when it is farther towards +y, the bottom of the image), tilt_y_deg =
-// atan(dZ/dX) (about the y axis; positive when it is farther towards +x, the right).
+// `neighbourhood_mm` weights each point by a Gaussian of its distance from the tool point
+// across the ground, so the ground around the tool decides and a ridge or furrow
+// elsewhere in the region does not tilt the fit; 0 weighs all points alike. Where the
+// ground steps, `max_surfaces` > 1 fits the pieces in turn, and the points within about
+// `tool_area_mm` of the tool point pick the one it stands on (the piece whose inliers
+// hold the most of them, by a Gaussian of that scale).
+//
+// Tilts are slope angles: tilt_x_deg = atan(dZ/dY) (the ground turned
+// about the camera's x axis; positive when it is farther towards +y, the bottom of the
+// image), tilt_y_deg = atan(dZ/dX) (about the y axis; positive when it is farther towards
+// +x, the right).
 //
 //   "estimate": {"type": "estimation.ground_plane",
-//                "params": {"tool_point": [0, 120]}}
+//                "params": {"tool_point": [0, 120], "neighbourhood_mm": 40,
+//                           "max_surfaces": 3, "tool_area_mm": 10}}
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -44,7 +55,9 @@ namespace {
 
 // A bound only: re-fitting stops as soon as the inlier set no longer changes.
 constexpr int kMaxRefits = 10;
-// Any fixed value: the same frame always gives the same plane.
+// Points farther than 3.7 neighbourhoods from the tool point are left out of the fit.
+constexpr double kNegligibleWeight = 1e-3;
+// Any fixed value: the same frame always gives the same surface.
 constexpr std::uint32_t kRansacSeed = 20240611;
 
 struct GridPixel {
@@ -57,20 +70,24 @@ struct GridPixel {
 struct SoilPoint {
   double x;
   double y;
-  double z;  // optical-centre depth, mm
+  double z;       // optical-centre depth, mm
+  double weight;  // in the fit: nearness to the tool point at the neighbourhood's scale
+  double vote;    // in choosing the tool's surface: nearness at the tool area's scale
 };
 
-class Plane {
+// 1/Z as a function of (x', y'): the plane c + a x' + b y'.
+class Surface {
  public:
-  explicit Plane(const Eigen::Vector3d& abc) : abc_(abc) {}
+  explicit Surface(const Eigen::Vector3d& cab) : cab_(cab) {}
 
   // The plane through three soil points, unless they are (nearly) collinear.
-  static std::optional<Plane> through(const SoilPoint& p, const SoilPoint& q, const SoilPoint& r) {
+  static std::optional<Surface> through(const SoilPoint& p, const SoilPoint& q,
+                                        const SoilPoint& r) {
     Eigen::Matrix3d rays;
-    rays << p.x, p.y, 1, q.x, q.y, 1, r.x, r.y, 1;
+    rays << 1, p.x, p.y, 1, q.x, q.y, 1, r.x, r.y;
     // Normalised coordinates span about 1, so this is twice the triangle's area in them.
     if (std::abs(rays.determinant()) < 1e-9) return std::nullopt;
-    return Plane(rays.partialPivLu().solve(Eigen::Vector3d(1 / p.z, 1 / q.z, 1 / r.z)));
+    return Surface(rays.partialPivLu().solve(Eigen::Vector3d(1 / p.z, 1 / q.z, 1 / r.z)));
   }
 
   bool inlier(const SoilPoint& point, double threshold_mm) const {
@@ -82,89 +99,99 @@ class Plane {
     return point.z - 1 / inverse_depth(point.x, point.y);
   }
 
-  // Z of the plane at camera-frame (X, Y); not finite when the plane never gets there.
+  // Z of the plane at camera-frame (X, Y) (c Z + a X + b Y = 1); not finite, or not
+  // positive, when the plane never gets there.
   double depth_at(double x_mm, double y_mm) const {
-    return (1 - abc_[0] * x_mm - abc_[1] * y_mm) / abc_[2];
+    return (1 - cab_[1] * x_mm - cab_[2] * y_mm) / cab_[0];
   }
-  double slope_x() const { return -abc_[0] / abc_[2]; }  // dZ/dX
-  double slope_y() const { return -abc_[1] / abc_[2]; }  // dZ/dY
+
+  double slope_x() const { return -cab_[1] / cab_[0]; }  // dZ/dX
+  double slope_y() const { return -cab_[2] / cab_[0]; }  // dZ/dY
 
  private:
-  double inverse_depth(double x, double y) const { return abc_[0] * x + abc_[1] * y + abc_[2]; }
+  double inverse_depth(double x, double y) const { return cab_[0] + cab_[1] * x + cab_[2] * y; }
 
-  Eigen::Vector3d abc_;
+  Eigen::Vector3d cab_;
 };
 
-// Least squares of the residuals along Z: Z - 1/m ~= Z^2 m - Z near the plane (m ~= 1/Z),
-// which is linear in (a, b, c).
-std::optional<Plane> fit(const std::vector<SoilPoint>& points, const std::vector<bool>& inliers) {
+// Weighted least squares of the residuals along Z: Z - 1/m ~= Z^2 m - Z near the plane
+// (m ~= 1/Z), which is linear in (c, a, b).
+std::optional<Surface> fit(const std::vector<SoilPoint>& points, const std::vector<bool>& inliers) {
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d right = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!inliers[i]) continue;
     const SoilPoint& p = points[i];
-    const Eigen::Vector3d row = p.z * p.z * Eigen::Vector3d(p.x, p.y, 1);
-    normal += row * row.transpose();
-    right += p.z * row;
+    const Eigen::Vector3d row = p.z * p.z * Eigen::Vector3d(1, p.x, p.y);
+    normal += p.weight * row * row.transpose();
+    right += p.weight * p.z * row;
   }
   const Eigen::LDLT<Eigen::Matrix3d> solver(normal);
   if (solver.info() != Eigen::Success ||
       solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
     return std::nullopt;  // fewer than three inliers, or all on a line
   }
-  return Plane(solver.solve(right));
+  return Surface(solver.solve(right));
 }
 
-// Marks the inliers of `plane`; returns how many there are and whether any flag changed.
-std::pair<std::size_t, bool> mark_inliers(const std::vector<SoilPoint>& points, const Plane& plane,
-                                          double threshold_mm, std::vector<bool>& inliers) {
-  std::size_t count = 0;
+// Marks the inliers of `surface`; returns their weight and whether any flag changed.
+std::pair<double, bool> mark_inliers(const std::vector<SoilPoint>& points, const Surface& surface,
+                                     double threshold_mm, std::vector<bool>& inliers) {
+  double weight = 0.0;
   bool changed = false;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const bool inlier = plane.inlier(points[i], threshold_mm);
+    const bool inlier = surface.inlier(points[i], threshold_mm);
     changed = changed || inlier != inliers[i];
     inliers[i] = inlier;
-    count += inlier ? 1 : 0;
+    weight += inlier ? points[i].weight : 0.0;
   }
-  return {count, changed};
+  return {weight, changed};
 }
-
-struct PlaneFit {
-  Plane plane;
-  std::size_t inliers;
-};
 
 // Least squares on the inliers of `plane`, re-selected and re-fitted until they no longer
 // change. Leaves the final inliers marked.
-std::optional<PlaneFit> refine(const std::vector<SoilPoint>& points, Plane plane,
-                               double threshold_mm, std::vector<bool>& inliers) {
+std::optional<Surface> refine(const std::vector<SoilPoint>& points, Surface plane,
+                              double threshold_mm, std::vector<bool>& inliers) {
   inliers.assign(points.size(), false);
-  auto [count, changed] = mark_inliers(points, plane, threshold_mm, inliers);
+  bool changed = mark_inliers(points, plane, threshold_mm, inliers).second;
   for (int refit = 0; refit < kMaxRefits && changed; ++refit) {
-    const std::optional<Plane> better = fit(points, inliers);
+    const std::optional<Surface> better = fit(points, inliers);
     if (!better) return std::nullopt;
     plane = *better;
-    std::tie(count, changed) = mark_inliers(points, plane, threshold_mm, inliers);
+    changed = mark_inliers(points, plane, threshold_mm, inliers).second;
   }
-  return PlaneFit{plane, count};
+  return plane;
 }
 
-std::optional<Plane> ransac(const std::vector<SoilPoint>& points, int hypotheses,
-                            double threshold_mm) {
+// Planes through three points drawn in proportion to their weight, scored by the weight of
+// their inliers.
+std::optional<Surface> ransac(const std::vector<SoilPoint>& points, int hypotheses,
+                              double threshold_mm) {
+  thread_local std::vector<double> cumulative;
+  cumulative.resize(points.size());
+  double total = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) cumulative[i] = total += points[i].weight;
   std::mt19937 random(kRansacSeed);
-  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
-  std::optional<Plane> best;
-  std::size_t best_inliers = 0;
+  std::uniform_real_distribution<double> pick(0.0, total);
+  const auto draw = [&]() -> const SoilPoint& {
+    const auto at = std::upper_bound(cumulative.begin(), cumulative.end(), pick(random));
+    return points[std::min<std::size_t>(at - cumulative.begin(), points.size() - 1)];
+  };
+  std::optional<Surface> best;
+  double best_weight = 0.0;
   for (int h = 0; h < hypotheses; ++h) {
-    const auto plane =
-        Plane::through(points[pick(random)], points[pick(random)], points[pick(random)]);
+    const SoilPoint& p = draw();
+    const SoilPoint& q = draw();
+    const SoilPoint& r = draw();
+    const auto plane = Surface::through(p, q, r);
     if (!plane) continue;
-    const auto inliers = static_cast<std::size_t>(
-        std::count_if(points.begin(), points.end(),
-                      [&](const SoilPoint& point) { return plane->inlier(point, threshold_mm); }));
-    if (inliers > best_inliers) {
+    double weight = 0.0;
+    for (const SoilPoint& point : points) {
+      if (plane->inlier(point, threshold_mm)) weight += point.weight;
+    }
+    if (weight > best_weight) {
       best = plane;
-      best_inliers = inliers;
+      best_weight = weight;
     }
   }
   return best;
@@ -221,6 +248,9 @@ class GroundPlaneEstimator final : public Transform {
         tool_point_mm_(parse_tool_point(context.params.json("tool_point"))),
         requirement_(soil_requirement(context.params)),
         threshold_mm_(context.params.number("outlier_threshold_mm")),
+        neighbourhood_mm_(context.params.number("neighbourhood_mm")),
+        tool_area_mm_(context.params.number("tool_area_mm")),
+        max_surfaces_(static_cast<int>(context.params.integer("max_surfaces"))),
         hypotheses_(static_cast<int>(context.params.integer("iterations"))),
         min_inlier_fraction_(context.params.number("min_inlier_fraction")),
         gates_(context.params),
@@ -271,7 +301,13 @@ class GroundPlaneEstimator final : public Transform {
     points.clear();
     for (const GridPixel& pixel : sampling.grid) {
       const float depth = soil_mm.at<float>(pixel.row, pixel.col);
-      if (std::isfinite(depth)) points.push_back({pixel.x, pixel.y, depth + camera.z_offset_mm});
+      if (!std::isfinite(depth)) continue;
+      const double z = depth + camera.z_offset_mm;
+      const double x = pixel.x * z;
+      const double y = pixel.y * z;
+      const double weight = nearness(x, y, neighbourhood_mm_);
+      if (weight < kNegligibleWeight) continue;
+      points.push_back({pixel.x, pixel.y, z, weight, nearness(x, y, tool_area_mm_)});
     }
     if (points.size() < 3) {
       out.invalidate(InvalidCause::kTooLittleSoil,
@@ -280,50 +316,98 @@ class GroundPlaneEstimator final : public Transform {
       return;
     }
 
-    const std::optional<Plane> guess = ransac(points, hypotheses_, threshold_mm_);
-    const std::optional<PlaneFit> fitted =
-        guess ? refine(points, *guess, threshold_mm_, inliers) : std::nullopt;
-    if (!fitted) {
+    const std::optional<Surface> tool_surface = surface_under_tool(points, inliers);
+    if (!tool_surface) {
       out.invalidate(InvalidCause::kNotOneSurface,
-                     "no plane fits the soil points (fewer than 3 inliers, or all on a line)");
+                     "no surface fits the soil points (too few inliers, or all on a line)");
       return;
     }
-    const double inlier_fraction =
-        static_cast<double>(fitted->inliers) / static_cast<double>(points.size());
+    const Surface& surface = *tool_surface;
+    const double inlier_weight = mark_inliers(points, surface, threshold_mm_, inliers).first;
+    double votes = 0.0;
+    double inlier_votes = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      votes += points[i].vote;
+      inlier_votes += inliers[i] ? points[i].vote : 0.0;
+    }
+    const double inlier_fraction = inlier_votes / votes;
     if (inlier_fraction < min_inlier_fraction_) {
       out.invalidate(InvalidCause::kNotOneSurface,
-                     "no plane fits the soil: " + one_decimal(100.0 * inlier_fraction) +
-                         " % of the soil points lie within " + one_decimal(threshold_mm_) +
-                         " mm of the best plane < " + one_decimal(100.0 * min_inlier_fraction_) +
-                         " %");
+                     "no surface fits the soil: " + one_decimal(100.0 * inlier_fraction) +
+                         " % of the soil points (by weight) lie within " +
+                         one_decimal(threshold_mm_) + " mm of the best one < " +
+                         one_decimal(100.0 * min_inlier_fraction_) + " %");
       return;
     }
-    const Plane& plane = fitted->plane;
-    const double depth_at_tool = plane.depth_at(tool_point_mm_[0], tool_point_mm_[1]);
+    const double depth_at_tool = surface.depth_at(tool_point_mm_[0], tool_point_mm_[1]);
     if (!std::isfinite(depth_at_tool) || depth_at_tool <= 0) {
       out.invalidate(InvalidCause::kOutOfRange,
-                     "the fitted plane does not lie in front of the camera at the tool point");
+                     "the fitted surface does not lie in front of the camera at the tool point");
       return;
     }
 
     double squares = 0.0;
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (!inliers[i]) continue;
-      const double residual_mm = plane.residual_mm(points[i]);
-      squares += residual_mm * residual_mm;
+      const double residual_mm = surface.residual_mm(points[i]);
+      squares += points[i].weight * residual_mm * residual_mm;
     }
-    out.spread_mm = std::sqrt(squares / static_cast<double>(fitted->inliers));
+    out.spread_mm = std::sqrt(squares / inlier_weight);
     out.distance_mm = depth_at_tool - camera.z_offset_mm;
-    out.tilt_x_deg = degrees(std::atan(plane.slope_y()));
-    out.tilt_y_deg = degrees(std::atan(plane.slope_x()));
+    out.tilt_x_deg = degrees(std::atan(surface.slope_y()));
+    out.tilt_y_deg = degrees(std::atan(surface.slope_x()));
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
+  }
+
+  // A Gaussian (sigma `scale_mm`) of a point's distance across the ground from the tool
+  // point; 1 for every point when the scale is 0.
+  double nearness(double x_mm, double y_mm, double scale_mm) const {
+    if (scale_mm <= 0) return 1.0;
+    const double dx = x_mm - tool_point_mm_[0];
+    const double dy = y_mm - tool_point_mm_[1];
+    return std::exp(-(dx * dx + dy * dy) / (2 * scale_mm * scale_mm));
+  }
+
+  // Up to max_surfaces surfaces, each fitted (RANSAC, then least squares) to the soil
+  // points the earlier ones left over; the tool's is the one whose inliers hold the most
+  // of the points around the tool point (votes). One surface: the best fit of them all.
+  std::optional<Surface> surface_under_tool(const std::vector<SoilPoint>& points,
+                                            std::vector<bool>& inliers) const {
+    thread_local std::vector<SoilPoint> left;
+    left = points;
+    std::optional<Surface> chosen;
+    double chosen_votes = -1.0;
+    for (int found = 0; found < max_surfaces_ && left.size() >= 3; ++found) {
+      const std::optional<Surface> guess = ransac(left, hypotheses_, threshold_mm_);
+      const std::optional<Surface> fitted =
+          guess ? refine(left, *guess, threshold_mm_, inliers) : std::nullopt;
+      if (!fitted) break;
+      double votes = 0.0;
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < left.size(); ++i) {
+        if (inliers[i]) {
+          votes += left[i].vote;
+        } else {
+          left[kept++] = left[i];
+        }
+      }
+      left.resize(kept);
+      if (votes > chosen_votes) {
+        chosen = fitted;
+        chosen_votes = votes;
+      }
+    }
+    return chosen;
   }
 
   const RegionOfInterest region_;
   const cv::Vec2d tool_point_mm_;
   const SoilRequirement requirement_;
   const double threshold_mm_;
+  const double neighbourhood_mm_;
+  const double tool_area_mm_;
+  const int max_surfaces_;
   const int hypotheses_;
   const double min_inlier_fraction_;
   const PlausibilityGates gates_;
@@ -348,16 +432,31 @@ StageDescriptor describe_ground_plane() {
           .describe("[x, y] in the ToF camera frame where the distance is read; [0, 0] = axis"),
       min_soil_fraction_param(),
       min_soil_pixels_param(),
+      ParamSpec::number("neighbourhood_mm", 0.0)
+          .range(0, 10000)
+          .in_unit("mm")
+          .describe("soil points weigh by a Gaussian (this sigma) of their distance from the "
+                    "tool point; 0 = all alike"),
+      ParamSpec::integer("max_surfaces", 1)
+          .range(1, 8)
+          .describe(
+              "ground pieces fitted in turn (steps, ridges); the one the tool stands on wins"),
+      ParamSpec::number("tool_area_mm", 0.0)
+          .range(0, 10000)
+          .in_unit("mm")
+          .describe("the ground within about this distance of the tool point picks its piece; "
+                    "0 = the largest piece"),
       ParamSpec::number("outlier_threshold_mm", 10.0)
           .range(0.1, 1000)
           .in_unit("mm")
-          .describe("soil points farther than this from the plane (along Z) are outliers"),
+          .describe("soil points farther than this from the surface (along Z) are outliers"),
       ParamSpec::integer("iterations", 64)
           .range(1, 10000)
           .describe("RANSAC hypotheses (3-point planes) tried before the least-squares re-fits"),
       ParamSpec::number("min_inlier_fraction", 0.5)
           .range(0, 1)
-          .describe("below this fraction of soil points on the plane the measurement is invalid"),
+          .describe("below this fraction of the soil points (weighed by their votes) on the "
+                    "tool's surface the measurement is invalid"),
       ParamSpec::integer("stride", 4)
           .range(1, 64)
           .in_unit("px")

@@ -1,12 +1,13 @@
 // segmentation.depth_aided: residue is what stands above the soil, whatever its colour.
 //
-//   depth ──► 3x3 median ──► soil surface (RANSAC plane through the farthest depths, then
-//   a local Gaussian-weighted surface) ──► height above it > height_mm? ──► residue ──►
+//   depth ──► 3x3 median ──► soil surface (the envelope of the farthest depths, then a
+//   local Gaussian-weighted surface) ──► height above it > height_mm? ──► residue ──►
 //   despeckle ──► dilate ──► mask, soil_depth
 //   color: not read (the port is there so that a graph swaps the variants by name)
 //
 // Invariant: a pixel is soil only when it has depth and lies no more than height_mm above
-// the surface fitted to the farthest depths; it is unknown only when it has no depth.
+// the surface fitted to the farthest depths; it is unknown when it has no depth (or, after
+// the 3x3 median, most of its neighbours have none).
 //
 //   "segment": {"type": "segmentation.depth_aided", "params": {"height_mm": 3}}
 #include <opencv2/core.hpp>
@@ -23,7 +24,8 @@ class DepthAided final : public Transform {
  public:
   explicit DepthAided(const StageContext& context)
       : height_mm_(context.params.number("height_mm")),
-        surface_(height_mm_, context.params.number("surface_px")),
+        surface_(height_mm_, context.params.number("surface_px"),
+                 context.params.number("envelope_px")),
         output_(context.params) {}
 
   void process(Frame& frame) override {
@@ -31,11 +33,13 @@ class DepthAided final : public Transform {
     const auto& depth = frame.input<DepthImage>(kDepthInput);
     check_residue_inputs(color, depth);
 
-    thread_local cv::Mat missing, height, residue;
+    thread_local cv::Mat missing, height, residue, unknown;
     mark_missing_depth(depth.mm, missing);
     surface_.heights(depth.mm, missing, ~missing, height);
     cv::compare(height, height_mm_, residue, cv::CMP_GT);  // NaN: no
-    output_.emit(frame, residue, missing, missing, depth.mm);
+    cv::compare(height, height, unknown, cv::CMP_NE);      // NaN: no surface near
+    cv::bitwise_or(unknown, missing, unknown);
+    output_.emit(frame, residue, unknown, unknown, depth.mm);
   }
 
  private:
@@ -52,7 +56,8 @@ StageDescriptor describe_depth_aided() {
   d.summary = "residue mask from the height above a robust soil surface (depth only)";
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
-  d.params = {height_mm_param(), surface_px_param(), dilation_px_param(), speckle_px_param(1)};
+  d.params = {height_mm_param(), surface_px_param(), envelope_px_param(), dilation_px_param(),
+              speckle_px_param(1)};
   d.concurrency = Concurrency::kParallel;
   d.create = factory<DepthAided>();
   return d;

@@ -11,8 +11,8 @@
 // taken for soil biases the distance by the residue's height; a soil pixel taken for
 // residue only costs visible soil. So a pixel is soil only when its colour is trusted and
 // on the soil side, it has depth, and it lies no more than height_mm above the surface;
-// it is unknown when either cue is missing (untrusted colour or no depth), and residue
-// when either cue says so.
+// it is unknown when either cue is missing (untrusted colour, no depth, or no soil surface
+// near it), and residue when either cue says so.
 //
 //   "segment": {"type": "segmentation.fusion", "params": {"index": "exg", "height_mm": 3}}
 #include <opencv2/core.hpp>
@@ -34,13 +34,14 @@ class Fusion final : public Transform {
                static_cast<int>(context.params.integer("smoothing_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
         height_mm_(context.params.number("height_mm")),
-        surface_(height_mm_, context.params.number("surface_px")),
+        surface_(height_mm_, context.params.number("surface_px"),
+                 context.params.number("envelope_px")),
         output_(context.params),
         notice_(context.log) {}
 
   void process(Frame& frame) override {
     const ResidueInputs in = read_residue_inputs(frame, min_value_);
-    thread_local cv::Mat by_color, soil_color, height, by_height;
+    thread_local cv::Mat by_color, soil_color, height, by_height, unknown;
     const IndexSplit split = index_.classify(in.color.bgr, in.untrusted, by_color);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());
     cv::subtract(by_color, in.untrusted, by_color);
@@ -50,7 +51,9 @@ class Fusion final : public Transform {
     surface_.heights(in.depth.mm, in.missing, soil_color, height);
     cv::compare(height, height_mm_, by_height, cv::CMP_GT);  // NaN: no
     cv::bitwise_or(by_color, by_height, by_color);
-    output_.emit(frame, by_color, cv::Mat(), in.unknown, in.depth.mm);
+    cv::compare(height, height, unknown, cv::CMP_NE);  // NaN: no surface, no height cue
+    cv::bitwise_or(unknown, in.unknown, unknown);
+    output_.emit(frame, by_color, cv::Mat(), unknown, in.depth.mm);
   }
 
  private:
@@ -71,8 +74,8 @@ StageDescriptor describe_fusion() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(), smoothing_px_param(), height_mm_param(), surface_px_param(),
-      dilation_px_param(), speckle_px_param(1),  min_value_param(),
+      color_index_param(), smoothing_px_param(), height_mm_param(),   surface_px_param(),
+      envelope_px_param(), dilation_px_param(),  speckle_px_param(1), min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<Fusion>();

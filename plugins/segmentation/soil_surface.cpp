@@ -102,25 +102,50 @@ std::optional<Plane> ransac(const std::vector<Point>& points) {
   return best;
 }
 
+// The envelope on the half-resolution grid: a morphological closing of the depth of the
+// pixels that may be soil (the farthest depth within the window, then the nearest of
+// those). Residue narrower than the window is gone from it; ground that slopes, curves
+// gently or steps over more than a window is kept as it is. NaN where no pixel within the
+// window may be soil.
+void envelope(const cv::Mat& depth, const cv::Mat& support, double window_px, cv::Mat& surface) {
+  constexpr float kNoSurface = std::numeric_limits<float>::max();
+  thread_local cv::Mat farthest, none;
+  farthest.create(depth.size(), CV_32FC1);
+  farthest.setTo(0);
+  depth.copyTo(farthest, support);
+  const int side = 2 * static_cast<int>(std::lround(window_px / 4)) + 1;  // odd, half scale
+  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, {side, side});
+  cv::dilate(farthest, surface, window);
+  cv::compare(surface, 0, none, cv::CMP_LE);
+  surface.setTo(kNoSurface, none);
+  cv::erode(surface, surface, window);
+  cv::compare(surface, kNoSurface, none, cv::CMP_EQ);
+  surface.setTo(std::numeric_limits<float>::quiet_NaN(), none);
+}
+
 // The local surface, on every second pixel of every second row (it varies over several
 // pixels, and this is a quarter of the work), starting from the plane. Each pass: the
 // soil is what lies no higher than height_mm above the current surface; the new surface
 // is the Gaussian-weighted mean of its depths, or stays where there is too little soil
 // nearby (under a hundredth of the kernel's weight).
-void follow_relief(const Plane& plane, const cv::Mat& depth, const cv::Mat& support,
-                   double height_mm, double surface_px, cv::Mat& surface) {
+void follow_relief(const std::optional<Plane>& plane, double envelope_px, const cv::Mat& depth,
+                   const cv::Mat& support, double height_mm, double surface_px, cv::Mat& surface) {
   thread_local cv::Mat depth_half, support_half, surface_half, height, soil, weight, weighted;
   cv::resize(depth, depth_half, {}, 0.5, 0.5, cv::INTER_NEAREST);
   cv::resize(support, support_half, {}, 0.5, 0.5, cv::INTER_NEAREST);
-  surface_half.create(depth_half.size(), CV_32FC1);
-  for (int row = 0; row < surface_half.rows; ++row) {
-    auto* s = surface_half.ptr<float>(row);
-    for (int col = 0; col < surface_half.cols; ++col) {
-      s[col] = static_cast<float>(plane.at(2 * col, 2 * row));
+  if (plane) {
+    surface_half.create(depth_half.size(), CV_32FC1);
+    for (int row = 0; row < surface_half.rows; ++row) {
+      auto* s = surface_half.ptr<float>(row);
+      for (int col = 0; col < surface_half.cols; ++col) {
+        s[col] = static_cast<float>(plane->at(2 * col, 2 * row));
+      }
     }
+  } else {
+    envelope(depth_half, support_half, envelope_px, surface_half);
   }
   const double sigma = surface_px / 2;
-  for (int pass = 0; pass < kLocalPasses; ++pass) {
+  for (int pass = 0; surface_px > 0 && pass < kLocalPasses; ++pass) {
     cv::subtract(surface_half, depth_half, height);
     cv::compare(height, height_mm, soil, cv::CMP_LT);
     cv::bitwise_and(soil, support_half, soil);
@@ -142,8 +167,8 @@ void follow_relief(const Plane& plane, const cv::Mat& depth, const cv::Mat& supp
 
 }  // namespace
 
-SoilSurface::SoilSurface(double height_mm, double surface_px)
-    : height_mm_(height_mm), surface_px_(surface_px) {}
+SoilSurface::SoilSurface(double height_mm, double surface_px, double envelope_px)
+    : height_mm_(height_mm), surface_px_(surface_px), envelope_px_(envelope_px) {}
 
 void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
                           const cv::Mat& candidates, cv::Mat& height_mm) const {
@@ -167,20 +192,24 @@ void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
       if (soil[col] != 0) points.push_back({double(col), double(row), d[col]});
     }
   }
-  const std::optional<Plane> plane = points.size() < kMinPoints ? std::nullopt : ransac(points);
-  height_mm.create(depth_mm.size(), CV_32FC1);
-  if (!plane) {
-    height_mm.setTo(kNaN);
-    return;
-  }
-  if (surface_px_ <= 0) {
-    surface.create(depth.size(), CV_32FC1);
-    for (int row = 0; row < depth.rows; ++row) {
-      auto* s = surface.ptr<float>(row);
-      for (int col = 0; col < depth.cols; ++col) s[col] = static_cast<float>(plane->at(col, row));
-    }
+  if (envelope_px_ > 0) {
+    follow_relief(std::nullopt, envelope_px_, depth, support, height_mm_, surface_px_, surface);
   } else {
-    follow_relief(*plane, depth, support, height_mm_, surface_px_, surface);
+    const std::optional<Plane> plane = points.size() < kMinPoints ? std::nullopt : ransac(points);
+    height_mm.create(depth_mm.size(), CV_32FC1);
+    if (!plane) {
+      height_mm.setTo(kNaN);
+      return;
+    }
+    if (surface_px_ <= 0) {
+      surface.create(depth.size(), CV_32FC1);
+      for (int row = 0; row < depth.rows; ++row) {
+        auto* s = surface.ptr<float>(row);
+        for (int col = 0; col < depth.cols; ++col) s[col] = static_cast<float>(plane->at(col, row));
+      }
+    } else {
+      follow_relief(plane, 0.0, depth, support, height_mm_, surface_px_, surface);
+    }
   }
   cv::subtract(surface, depth, height_mm);
   height_mm.setTo(kNaN, no_depth);
@@ -198,6 +227,15 @@ ParamSpec surface_px_param() {
       .range(0, 100)
       .in_unit("px")
       .describe("the soil surface follows relief at this scale (Gaussian sigma); 0 = a plane");
+}
+
+ParamSpec envelope_px_param() {
+  return ParamSpec::number("envelope_px", 0.0)
+      .range(0, 400)
+      .in_unit("px")
+      .describe(
+          "0: the surface starts from a RANSAC plane through the farthest depths; > 0: "
+          "from their envelope over this window (steps, ridges; no pile wider than it)");
 }
 
 }  // namespace tilth::segmentation

@@ -1,6 +1,7 @@
 // The soil surface under the residue, from depth alone, and each pixel's height above it.
 // Residue lies on the soil, so the soil is the farthest surface the camera sees: a robust
-// plane through the farthest depths, then a local surface that follows the soil's relief.
+// plane through the farthest depths (or, for ground that steps or curves, their envelope
+// over a window wider than the residue), then a local surface that follows the relief.
 #pragma once
 
 #include <opencv2/core/mat.hpp>
@@ -13,23 +14,26 @@ class SoilSurface {
  public:
   // `height_mm`: pixels higher than this are not soil while the local surface is fitted.
   // `surface_px`: the local surface is a Gaussian-weighted mean (sigma in pixels) of the
-  // soil depths around each pixel; 0 keeps the plane.
-  SoilSurface(double height_mm, double surface_px);
+  // soil depths around each pixel; 0 keeps the plane. `envelope_px` > 0 starts from the
+  // envelope over a window of that side (pixels) instead of the plane.
+  SoilSurface(double height_mm, double surface_px, double envelope_px);
 
   // Height above the soil surface in mm, positive towards the camera, of the 3x3 median
   // depth (CV_32FC1): NaN where `missing` or where most of the 3x3 neighbours have no
-  // depth, and everywhere when no surface could be found. Only pixels marked in
-  // `candidates` may support the surface.
+  // depth, where no pixel within the envelope's window may be soil, and everywhere when no
+  // plane could be found. Only pixels marked in `candidates` may support the surface.
   void heights(const cv::Mat& depth_mm, const cv::Mat& missing, const cv::Mat& candidates,
                cv::Mat& height_mm) const;
 
  private:
   const double height_mm_;
   const double surface_px_;
+  const double envelope_px_;
 };
 
-// The parameters of the stages that use it: `height_mm` and `surface_px`.
+// The parameters of the stages that use it: `height_mm`, `surface_px` and `envelope_px`.
 ParamSpec height_mm_param();
 ParamSpec surface_px_param();
+ParamSpec envelope_px_param();
 
 }  // namespace tilth::segmentation

@@ -10,10 +10,6 @@ namespace {
 constexpr double kStepMm = 1.0;
 constexpr int kBisections = 8;
 
-// The sun 50 degrees above the horizon; camera z points down, so "up" is -z.
-const cv::Vec3d kToSun = cv::normalize(cv::Vec3d(0.45, -0.35, -std::tan(50.0 * CV_PI / 180.0)));
-constexpr double kAmbient = 0.45;
-
 }  // namespace
 
 SurfaceHit cast_ray(const SoilScene& scene, const cv::Vec3d& origin, const cv::Vec3d& direction,
@@ -43,7 +39,18 @@ SurfaceHit cast_ray(const SoilScene& scene, const cv::Vec3d& origin, const cv::V
   return {exact_t * cv::norm(direction), origin[2] + exact_t, x, y, scene.material(x, y)};
 }
 
-double sunlight(const SoilScene& scene, const SurfaceHit& hit, bool shadows) {
+Lighting::Lighting(const ScenePreset& preset)
+    : sky_bgr(static_cast<float>(preset.sky_bgr[0]), static_cast<float>(preset.sky_bgr[1]),
+              static_cast<float>(preset.sky_bgr[2])),
+      shadows(preset.shadows) {
+  constexpr double kDegree = CV_PI / 180.0;
+  const double elevation = preset.sun_elevation_deg * kDegree;
+  const double azimuth = preset.sun_azimuth_deg * kDegree;
+  to_sun = {std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+            -std::sin(elevation)};
+}
+
+cv::Vec3f sunlight(const SoilScene& scene, const SurfaceHit& hit, const Lighting& lighting) {
   constexpr double kDelta = 0.5;
   const double dzdx = (scene.surface_z(hit.x_mm + kDelta, hit.y_mm) -
                        scene.surface_z(hit.x_mm - kDelta, hit.y_mm)) /
@@ -53,16 +60,17 @@ double sunlight(const SoilScene& scene, const SurfaceHit& hit, bool shadows) {
                       (2 * kDelta);
   // Surface z(x, y); its normal pointing up (towards -z).
   const cv::Vec3d normal = cv::normalize(cv::Vec3d(dzdx, dzdy, -1.0));
-  const double direct = std::max(0.0, normal.dot(kToSun));
-  if (direct == 0.0 || !shadows) return kAmbient + (1.0 - kAmbient) * direct;
+  const auto direct = static_cast<float>(std::max(0.0, normal.dot(lighting.to_sun)));
+  const cv::Vec3f lit = lighting.sky_bgr + (cv::Vec3f::all(1.0f) - lighting.sky_bgr) * direct;
+  if (direct == 0.0f || !lighting.shadows) return lit;
   // March towards the sun until the ray is above everything.
   const double top = scene.top_z();
   for (double s = 1.0;; s += 1.0) {
-    const cv::Vec3d p = cv::Vec3d(hit.x_mm, hit.y_mm, hit.z_mm) + s * kToSun;
+    const cv::Vec3d p = cv::Vec3d(hit.x_mm, hit.y_mm, hit.z_mm) + s * lighting.to_sun;
     if (p[2] < top) break;
-    if (scene.surface_z(p[0], p[1]) < p[2] - 0.25) return kAmbient;
+    if (scene.surface_z(p[0], p[1]) < p[2] - 0.25) return lighting.sky_bgr;
   }
-  return kAmbient + (1.0 - kAmbient) * direct;
+  return lit;
 }
 
 }  // namespace tilth::synthetic

@@ -20,7 +20,17 @@ struct SurfaceHit {
 SurfaceHit cast_ray(const SoilScene& scene, const cv::Vec3d& origin, const cv::Vec3d& direction,
                     double shift_x_mm);
 
-// Diffuse light at a hit: ambient plus sun (unless the surface towards the sun hides it).
-double sunlight(const SoilScene& scene, const SurfaceHit& hit, bool shadows);
+// The sun and the sky of a preset.
+struct Lighting {
+  explicit Lighting(const ScenePreset& preset);
+
+  cv::Vec3d to_sun;   // unit vector in the camera frame (up is -z)
+  cv::Vec3f sky_bgr;  // the light where the sun does not reach, relative to the sun's
+  bool shadows;
+};
+
+// Diffuse light (BGR) at a hit: the sky's plus the sun's, unless the surface towards the
+// sun hides it.
+cv::Vec3f sunlight(const SoilScene& scene, const SurfaceHit& hit, const Lighting& lighting);
 
 }  // namespace tilth::synthetic

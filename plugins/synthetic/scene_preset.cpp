@@ -3,6 +3,89 @@
 #include "tilth/error.h"
 
 namespace tilth::synthetic {
+namespace {
+
+// What the sun and the camera of a real field add to a preset: a dimmer, bluish sky in
+// the shadows, ToF noise that grows on dark surfaces, and multipath near standing residue.
+ScenePreset in_the_field(ScenePreset preset, double sun_elevation_deg) {
+  preset.sun_elevation_deg = sun_elevation_deg;
+  preset.sky_bgr = {0.42, 0.34, 0.27};
+  preset.reflectivity_noise = true;
+  preset.multipath = 0.02;
+  return preset;
+}
+
+// The conditions the paper's cases lack, each alone on top of a paper-like scene (`base`:
+// case A's stubble on undisturbed soil), so a scenario that fails names its cause.
+void add_field_conditions(std::vector<ScenePreset>& list, const ScenePreset& base) {
+  ScenePreset low_sun = in_the_field(base, 25.0);
+  low_sun.name = "low_sun";
+  low_sun.description =
+      "a sun 25 degrees high: long, bluish shadows of stubble and 300 straws on soil and on "
+      "lower straw, 518 mm";
+  low_sun.straws = 300;
+  list.push_back(low_sun);
+
+  ScenePreset heavy = in_the_field(base, 35.0);
+  heavy.name = "heavy_cover";
+  heavy.description =
+      "about 85 % cover: 500 straws, the lower half weathered dark grey, shadows, 518 mm";
+  heavy.straws = 500;
+  heavy.weathered_fraction = 0.5;
+  list.push_back(heavy);
+
+  ScenePreset tilted = in_the_field(base, 45.0);
+  tilted.name = "tilted";
+  tilted.description = "ground sloping 3 degrees down towards the image bottom, 150 straws, 585 mm";
+  tilted.ground_distance_mm = 585.0;
+  tilted.tilt_x_deg = 3.0;
+  tilted.straws = 150;
+  list.push_back(tilted);
+
+  ScenePreset tilted_5 = tilted;
+  tilted_5.name = "tilted_5";
+  tilted_5.description = "ground tilted 5 degrees and rolled -5 degrees, 150 straws, 585 mm";
+  tilted_5.tilt_y_deg = -5.0;
+  tilted_5.tilt_x_deg = 5.0;
+  list.push_back(tilted_5);
+
+  ScenePreset ridges = in_the_field(base, 45.0);
+  ridges.name = "ridges";
+  ridges.description =
+      "ridges and furrows 20 mm high every 600 mm crossing the region, 150 straws, 518 mm";
+  ridges.ridge_mm = 20.0;
+  ridges.ridge_period_mm = 600.0;
+  ridges.ridge_angle_deg = 70.0;
+  ridges.straws = 150;
+  list.push_back(ridges);
+
+  ScenePreset stubble = in_the_field(base, 40.0);
+  stubble.name = "tall_stubble";
+  stubble.description =
+      "300 stalks 30-150 mm high with their shadows and multipath, 100 straws, 518 mm";
+  stubble.stubble = 300;
+  stubble.stubble_height_mm = 90.0;
+  stubble.stubble_height_spread_mm = 60.0;
+  stubble.multipath = 0.03;
+  stubble.straws = 100;
+  list.push_back(stubble);
+
+  ScenePreset steps = in_the_field(base, 45.0);
+  steps.name = "steps";
+  steps.description =
+      "moving ground: a 1600 mm track of soil steps 2-12 mm high every 200 mm, with stubble "
+      "and straw, 518 mm";
+  steps.stubble = 40;
+  steps.straws = 400;
+  steps.relief_mm = 1.0;
+  steps.track_length_mm = 1600.0;
+  steps.layers_mm = {0.0, 4.0, 9.0, 3.0, -2.0, 6.0, 12.0, 5.0};
+  steps.speed_mm_per_s = 400.0;
+  steps.frames = 120;
+  list.push_back(steps);
+}
+
+}  // namespace
 
 const std::vector<ScenePreset>& scene_presets() {
   // Static cases follow the paper's section 3.1: 518 mm, stubble 60-70 mm high, then
@@ -79,6 +162,7 @@ const std::vector<ScenePreset>& scene_presets() {
     field.stubble = 40;
     field.straws = 250;
     list.push_back(field);
+    add_field_conditions(list, a);
     return list;
   }();
   return presets;

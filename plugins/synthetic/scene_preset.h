@@ -1,7 +1,10 @@
 // Named scene presets: the paper's static cases A-E, the dynamic layered-soil platform,
-// a field case, and hard cases for segmentation. Each is a recipe for a SoilScene.
+// a field case, and the hard conditions a field brings (shadows of a low sun, heavy and
+// weathered cover, tilted, ridged and stepped ground, tall mixed stubble). Each is a
+// recipe for a SoilScene.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -13,10 +16,29 @@ struct ScenePreset {
   double ground_distance_mm = 518.0;  // mounting surface to the soil datum
   int stubble = 0;                    // standing stubble stalks
   double stubble_height_mm = 65.0;
-  int straws = 0;          // lying straws, stacked where they cross
-  bool wet_straw = false;  // dark, soil-like straw
+  double stubble_height_spread_mm = 5.0;  // heights are uniform in +-spread
+  int straws = 0;                         // lying straws, stacked where they cross
+  bool wet_straw = false;                 // dark, soil-like straw
+  double weathered_fraction = 0.0;        // the first-laid (lowest) straws: dark grey, weathered
+  double relief_mm = 1.5;                 // micro-relief amplitude of the soil
+  // The ground's shape under the micro-relief, which the truth follows: slopes (about
+  // the camera's x axis, farther towards +y when positive; about the y axis, farther
+  // towards +x), and ridges and furrows (peak to peak, period, direction from +x).
+  double tilt_x_deg = 0.0;
+  double tilt_y_deg = 0.0;
+  double ridge_mm = 0.0;
+  double ridge_period_mm = 500.0;
+  double ridge_angle_deg = 0.0;
+  // Light: the sun's elevation and azimuth (from +x towards +y), and the sky's light in
+  // shadow (BGR, relative to the sun's 1): bluish and dim in a real field.
   bool shadows = true;
-  double relief_mm = 1.5;  // micro-relief amplitude of the soil
+  double sun_elevation_deg = 64.45;
+  double sun_azimuth_deg = -37.87;
+  std::array<double, 3> sky_bgr{0.45, 0.45, 0.45};
+  // ToF: range noise that also grows as the surface reflects less (amplitude-limited),
+  // and multipath: a range bias of this many mm per mm of residue standing nearby.
+  bool reflectivity_noise = false;
+  double multipath = 0.0;
   // The dynamic platform: the ground moves under the camera along x; soil layers of
   // these thicknesses lie along a track of this length.
   double track_length_mm = 0.0;

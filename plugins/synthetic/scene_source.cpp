@@ -5,9 +5,11 @@
 // ToF: each pixel casts four rays over its footprint; where they meet different
 // surfaces (straw edges) the pixel reports their mean range, the mixed pixel a real ToF
 // camera produces, and sometimes drops out; elsewhere it reports its centre ray exactly.
-// Range noise grows with the square of the range; values are quantised to 16-bit gray.
-// Colour: reflectance times sunlight (with shadows) plus sensor noise, optionally as a
-// Bayer mosaic. Static presets are rendered once and re-noised per frame; moving ground
+// Range noise grows with the square of the range (and, when the preset says so, as the
+// surface reflects less); multipath lengthens the range near standing residue; values are
+// quantised to 16-bit gray.
+// Colour: reflectance times sun and sky light (with shadows) plus sensor noise, optionally
+// as a Bayer mosaic. Static presets are rendered once and re-noised per frame; moving ground
 // is rendered per frame.
 #include <chrono>
 #include <cmath>
@@ -31,6 +33,8 @@ namespace {
 constexpr double kSimulatedCameraFps = 30.0;
 constexpr std::int64_t kStartNs = 1'000'000'000;
 constexpr std::int64_t kColorLagNs = 400'000;  // the colour camera fires 0.4 ms later
+// The reflectance at which `noise_mm` holds when the noise depends on reflectance.
+constexpr double kReferenceReflectance = 0.4;
 
 // Normalised, undistorted ray directions (z = 1) of pixel positions of a camera.
 cv::Mat ray_directions(const CameraIntrinsics& camera, const std::vector<cv::Point2f>& pixels) {
@@ -73,6 +77,7 @@ class SceneSource final : public Source {
       : rig_(load_calibration(context.params.path("calibration"))),
         carried_rig_(std::make_shared<const RigCalibration>(rig_)),
         preset_(scene_preset(context.params.string("preset"))),
+        lighting_(preset_),
         seed_(static_cast<std::uint64_t>(context.params.integer("seed"))),
         frames_(context.params.integer("frames") > 0 ? context.params.integer("frames")
                                                      : preset_.frames),
@@ -121,7 +126,7 @@ class SceneSource final : public Source {
     ColorImage color = color_frame(rng);
     color.device_timestamp_ns = device_ns + kColorLagNs;
     GroundTruth truth;
-    truth.distance_mm = soil_z_at_axis(shift) - rig_.depth.z_offset_mm;
+    truth.distance_mm = soil_z_ - scene_->ground_height_mm(shift, 0.0) - rig_.depth.z_offset_mm;
     truth.residue_mask = truth_mask_.clone();
 
     const auto host_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -168,6 +173,7 @@ class SceneSource final : public Source {
     const int width = rig_.depth.width;
     range_mm_.create(rig_.depth.height, width, CV_32FC1);
     mixed_.create(rig_.depth.height, width, CV_8UC1);
+    reflectance_.create(rig_.depth.height, width, CV_32FC1);
     truth_mask_.create(rig_.depth.height, width, CV_8UC1);
     const cv::Vec3d tof_origin(0, 0, 0);
     cv::parallel_for_(cv::Range(0, rig_.depth.height), [&](const cv::Range& rows) {
@@ -178,20 +184,24 @@ class SceneSource final : public Source {
           double sum = 0.0;
           double nearest = 1e9;
           double farthest = 0.0;
+          double reflectance = 0.0;
           for (int k = 0; k < 4; ++k) {
             const cv::Vec2f ray = tof_corner_rays_.at<cv::Vec2f>(index * 4 + k);
             const SurfaceHit hit = cast_ray(*scene_, tof_origin, {ray[0], ray[1], 1.0}, shift);
             residue += hit.material != Material::kSoil;
-            sum += measured(hit, ray);
+            sum += measured(hit);
+            const cv::Vec3f albedo = scene_->albedo(hit.x_mm, hit.y_mm);
+            reflectance += (albedo[0] + albedo[1] + albedo[2]) / 12.0;
             nearest = std::min(nearest, hit.range_mm);
             farthest = std::max(farthest, hit.range_mm);
           }
           double range = sum / 4.0;
           if (residue == 0 && farthest - nearest < 2.0) {
             const cv::Vec2f ray = tof_centre_rays_.at<cv::Vec2f>(index);
-            range = measured(cast_ray(*scene_, tof_origin, {ray[0], ray[1], 1.0}, shift), ray);
+            range = measured(cast_ray(*scene_, tof_origin, {ray[0], ray[1], 1.0}, shift));
           }
           range_mm_.at<float>(v, u) = static_cast<float>(range);
+          reflectance_.at<float>(v, u) = static_cast<float>(reflectance);
           mixed_.at<std::uint8_t>(v, u) = farthest - nearest > 10.0;
           truth_mask_.at<std::uint8_t>(v, u) = residue == 0   ? ResidueMask::kSoil
                                                : residue == 4 ? ResidueMask::kResidue
@@ -208,17 +218,19 @@ class SceneSource final : public Source {
           cv::Vec3d direction = colour_rotation_ * cv::Vec3d(ray[0], ray[1], 1.0);
           direction /= direction[2];
           const SurfaceHit hit = cast_ray(*scene_, colour_origin_, direction, shift);
-          const double light = sunlight(*scene_, hit, preset_.shadows);
           radiance_.at<cv::Vec3f>(v, u) =
-              scene_->albedo(hit.x_mm, hit.y_mm) * static_cast<float>(light);
+              scene_->albedo(hit.x_mm, hit.y_mm).mul(sunlight(*scene_, hit, lighting_));
         }
       }
     });
   }
 
-  // What the ToF camera measures along a ray: the range (radial) or its z.
-  double measured(const SurfaceHit& hit, const cv::Vec2f&) const {
-    return rig_.depth.depth_measure == DepthMeasure::kRadial ? hit.range_mm : hit.z_mm;
+  // What the ToF camera measures along a ray: the range (radial) or its z, lengthened by
+  // the light that reaches the hit by way of residue standing near it.
+  double measured(const SurfaceHit& hit) const {
+    const double multipath = preset_.multipath * scene_->clutter_mm(hit.x_mm, hit.y_mm);
+    return (rig_.depth.depth_measure == DepthMeasure::kRadial ? hit.range_mm : hit.z_mm) +
+           multipath;
   }
 
   RawTofFrame tof_frame(cv::RNG& rng) const {
@@ -228,7 +240,12 @@ class SceneSource final : public Source {
     for (int v = 0; v < range_mm_.rows; ++v) {
       for (int u = 0; u < range_mm_.cols; ++u) {
         const double range = range_mm_.at<float>(v, u);
-        const double sigma = noise_mm_at_500_ * (range / 500.0) * (range / 500.0);
+        const double dimness =
+            preset_.reflectivity_noise
+                ? std::sqrt(kReferenceReflectance /
+                            std::max(0.05, static_cast<double>(reflectance_.at<float>(v, u))))
+                : 1.0;
+        const double sigma = noise_mm_at_500_ * (range / 500.0) * (range / 500.0) * dimness;
         const bool drop = rng.uniform(0.0, 1.0) < dropout_ ||
                           (mixed_.at<std::uint8_t>(v, u) && rng.uniform(0.0, 1.0) < 0.2);
         const double gray = (range + rng.gaussian(sigma) - rig_.depth.gray_offset_mm) / mu;
@@ -261,18 +278,10 @@ class SceneSource final : public Source {
     return color;
   }
 
-  // The truth: the soil datum, raised by the soil layer under the optical axis.
-  double soil_z_at_axis(double shift) const {
-    if (preset_.layers_mm.empty()) return soil_z_;
-    const double segment = preset_.track_length_mm / static_cast<double>(preset_.layers_mm.size());
-    const int layer = std::clamp(static_cast<int>(std::floor(shift / segment)), 0,
-                                 static_cast<int>(preset_.layers_mm.size()) - 1);
-    return soil_z_ - preset_.layers_mm[layer];
-  }
-
   const RigCalibration rig_;
   const std::shared_ptr<const RigCalibration> carried_rig_;  // the frames carry it
   ScenePreset preset_;
+  const Lighting lighting_;
   const std::uint64_t seed_;
   const std::int64_t frames_;
   PlaybackClock clock_;
@@ -288,10 +297,11 @@ class SceneSource final : public Source {
   cv::Mat colour_rays_;      // CV_32FC2 per colour pixel, in the colour camera frame
   cv::Matx33d colour_rotation_;
   cv::Vec3d colour_origin_;
-  cv::Mat range_mm_;    // CV_32F: noise-free measured range
-  cv::Mat mixed_;       // CV_8U: 1 where the footprint spans surfaces > 10 mm apart
-  cv::Mat truth_mask_;  // CV_8U: ResidueMask values
-  cv::Mat radiance_;    // CV_32FC3: reflectance x light
+  cv::Mat range_mm_;     // CV_32F: noise-free measured range
+  cv::Mat mixed_;        // CV_8U: 1 where the footprint spans surfaces > 10 mm apart
+  cv::Mat reflectance_;  // CV_32F: mean reflectance over the footprint
+  cv::Mat truth_mask_;   // CV_8U: ResidueMask values
+  cv::Mat radiance_;     // CV_32FC3: reflectance x light
   std::int64_t index_;
   const std::int64_t first_frame_ = index_;
 };

@@ -14,6 +14,8 @@ const cv::Vec3f kSoil(0.16f, 0.23f, 0.32f);
 const cv::Vec3f kStraw(0.38f, 0.70f, 0.82f);
 const cv::Vec3f kWetStraw(0.14f, 0.22f, 0.30f);
 const cv::Vec3f kStubble(0.32f, 0.60f, 0.72f);
+const cv::Vec3f kWeathered(0.15f, 0.17f, 0.19f);  // grey, darker than the soil
+constexpr double kClutterSigmaMm = 10.0;
 
 cv::Vec3b to_bytes(const cv::Vec3f& reflectance) {
   return {cv::saturate_cast<std::uint8_t>(reflectance[0] * 255.0f),
@@ -25,17 +27,21 @@ cv::Vec3b to_bytes(const cv::Vec3f& reflectance) {
 
 SoilScene::SoilScene(const ScenePreset& preset, double soil_z_mm, cv::Rect2d area, double cell_mm,
                      std::uint64_t seed)
-    : soil_z_(static_cast<float>(soil_z_mm)), area_(area), cell_mm_(cell_mm) {
+    : preset_(preset), soil_z_(static_cast<float>(soil_z_mm)), area_(area), cell_mm_(cell_mm) {
   const int cols = static_cast<int>(std::ceil(area.width / cell_mm));
   const int rows = static_cast<int>(std::ceil(area.height / cell_mm));
   cv::RNG rng(seed);
   soil_height_.create(rows, cols, CV_32FC1);
   material_ = cv::Mat(rows, cols, CV_8UC1, cv::Scalar(static_cast<int>(Material::kSoil)));
   albedo_.create(rows, cols, CV_8UC3);
-  add_soil(preset, rng);
+  add_soil(rng);
   height_ = soil_height_.clone();
-  add_stubble(preset, rng);
-  add_straws(preset, rng);
+  add_stubble(rng);
+  add_straws(rng);
+  if (preset.multipath > 0.0) {
+    cv::subtract(height_, soil_height_, clutter_);
+    cv::GaussianBlur(clutter_, clutter_, cv::Size(0, 0), kClutterSigmaMm / cell_mm);
+  }
   double highest = 0.0;
   cv::minMaxLoc(height_, nullptr, &highest);
   top_z_ = soil_z_ - static_cast<float>(highest);
@@ -46,6 +52,31 @@ float SoilScene::soil_z(double x, double y) const {
   const int r = cell_y(y);
   if (c < 0 || r < 0 || c >= soil_height_.cols || r >= soil_height_.rows) return soil_z_;
   return soil_z_ - soil_height_.at<float>(r, c);
+}
+
+double SoilScene::ground_height_mm(double x, double y) const {
+  constexpr double kDegree = CV_PI / 180.0;
+  double h =
+      -y * std::tan(preset_.tilt_x_deg * kDegree) - x * std::tan(preset_.tilt_y_deg * kDegree);
+  if (preset_.ridge_mm > 0.0) {
+    const double angle = preset_.ridge_angle_deg * kDegree;
+    const double across = x * std::cos(angle) + y * std::sin(angle);
+    h += 0.5 * preset_.ridge_mm * std::cos(2 * CV_PI * across / preset_.ridge_period_mm);
+  }
+  if (!preset_.layers_mm.empty()) {
+    const double segment = preset_.track_length_mm / static_cast<double>(preset_.layers_mm.size());
+    const int layer = std::clamp(static_cast<int>(std::floor(x / segment)), 0,
+                                 static_cast<int>(preset_.layers_mm.size()) - 1);
+    h += preset_.layers_mm[layer];
+  }
+  return h;
+}
+
+float SoilScene::clutter_mm(double x, double y) const {
+  if (clutter_.empty()) return 0.0f;
+  const int c = std::clamp(cell_x(x), 0, clutter_.cols - 1);
+  const int r = std::clamp(cell_y(y), 0, clutter_.rows - 1);
+  return clutter_.at<float>(r, c);
 }
 
 Material SoilScene::material(double x, double y) const {
@@ -63,10 +94,9 @@ cv::Vec3f SoilScene::albedo(double x, double y) const {
 }
 
 // Micro-relief: a few sinusoids with wavelengths of 15-80 mm (many periods over a region
-// of interest, so its mean there is the datum) plus fine roughness; soil colour varies
-// slowly with clods and moisture. On the track, layers of soil of the preset's
-// thicknesses follow one another along x.
-void SoilScene::add_soil(const ScenePreset& preset, cv::RNG& rng) {
+// of interest, so its mean there is the datum) plus fine roughness, on the ground's shape
+// (tilt, ridges, the track's layers); soil colour varies slowly with clods and moisture.
+void SoilScene::add_soil(cv::RNG& rng) {
   struct Wave {
     double kx, ky, phase, amplitude;
   };
@@ -76,43 +106,36 @@ void SoilScene::add_soil(const ScenePreset& preset, cv::RNG& rng) {
     const double angle = rng.uniform(0.0, CV_PI);
     waves.push_back({2 * CV_PI / wavelength * std::cos(angle),
                      2 * CV_PI / wavelength * std::sin(angle), rng.uniform(0.0, 2 * CV_PI),
-                     preset.relief_mm / 3.0});
+                     preset_.relief_mm / 3.0});
   }
   cv::Mat roughness(soil_height_.size(), CV_32FC1);
-  rng.fill(roughness, cv::RNG::NORMAL, 0.0, preset.relief_mm * 0.15);
+  rng.fill(roughness, cv::RNG::NORMAL, 0.0, preset_.relief_mm * 0.15);
   cv::Mat tint(soil_height_.size(), CV_32FC1);
   rng.fill(tint, cv::RNG::NORMAL, 0.0, 1.0);
   cv::GaussianBlur(tint, tint, cv::Size(0, 0), 6.0 / cell_mm_);
   cv::normalize(tint, tint, -0.18, 0.18, cv::NORM_MINMAX);
-  const double segment =
-      preset.layers_mm.empty()
-          ? 0.0
-          : preset.track_length_mm / static_cast<double>(preset.layers_mm.size());
   for (int r = 0; r < soil_height_.rows; ++r) {
     const double y = area_.y + (r + 0.5) * cell_mm_;
     for (int c = 0; c < soil_height_.cols; ++c) {
       const double x = area_.x + (c + 0.5) * cell_mm_;
-      double h = roughness.at<float>(r, c);
+      double h = roughness.at<float>(r, c) + ground_height_mm(x, y);
       for (const auto& wave : waves)
         h += wave.amplitude * std::sin(wave.kx * x + wave.ky * y + wave.phase);
-      if (segment > 0.0) {
-        const int layer = std::clamp(static_cast<int>(std::floor(x / segment)), 0,
-                                     static_cast<int>(preset.layers_mm.size()) - 1);
-        h += preset.layers_mm[layer];
-      }
       soil_height_.at<float>(r, c) = static_cast<float>(h);
       albedo_.at<cv::Vec3b>(r, c) = to_bytes(kSoil * (1.0f + tint.at<float>(r, c)));
     }
   }
 }
 
-// Standing stalks: discs of 3-5 mm diameter, 60-70 mm high (cut wheat stubble).
-void SoilScene::add_stubble(const ScenePreset& preset, cv::RNG& rng) {
-  for (int i = 0; i < preset.stubble; ++i) {
+// Standing stalks: discs of 3-5 mm diameter, of the preset's heights (cut wheat stubble:
+// 60-70 mm).
+void SoilScene::add_stubble(cv::RNG& rng) {
+  for (int i = 0; i < preset_.stubble; ++i) {
     const double cx = rng.uniform(area_.x, area_.x + area_.width);
     const double cy = rng.uniform(area_.y, area_.y + area_.height);
     const double radius = rng.uniform(1.5, 2.5);
-    const double top = preset.stubble_height_mm + rng.uniform(-5.0, 5.0);
+    const double top = preset_.stubble_height_mm + rng.uniform(-preset_.stubble_height_spread_mm,
+                                                               preset_.stubble_height_spread_mm);
     const float shade = static_cast<float>(rng.uniform(0.85, 1.1));
     for (int r = cell_y(cy - radius); r <= cell_y(cy + radius); ++r) {
       for (int c = cell_x(cx - radius); c <= cell_x(cx + radius); ++c) {
@@ -133,11 +156,14 @@ void SoilScene::add_stubble(const ScenePreset& preset, cv::RNG& rng) {
 // Lying straws: cylinders of 3-6 mm diameter and 40-250 mm length at random angles.
 // Each rests on the soil or the highest straw under its axis, so straws stack where
 // they cross; standing stubble pokes through them rather than holding them up (a
-// height field cannot show a straw floating on a stalk).
-void SoilScene::add_straws(const ScenePreset& preset, cv::RNG& rng) {
-  const cv::Vec3f colour = preset.wet_straw ? kWetStraw : kStraw;
+// height field cannot show a straw floating on a stalk). The first-laid straws, which end
+// up at the bottom, are weathered when the preset says so.
+void SoilScene::add_straws(cv::RNG& rng) {
+  const cv::Vec3f fresh = preset_.wet_straw ? kWetStraw : kStraw;
+  const int weathered = static_cast<int>(preset_.weathered_fraction * preset_.straws);
   cv::Mat lying = soil_height_.clone();
-  for (int i = 0; i < preset.straws; ++i) {
+  for (int i = 0; i < preset_.straws; ++i) {
+    const cv::Vec3f colour = i < weathered ? kWeathered : fresh;
     const double cx = rng.uniform(area_.x, area_.x + area_.width);
     const double cy = rng.uniform(area_.y, area_.y + area_.height);
     const double angle = rng.uniform(0.0, CV_PI);

@@ -27,8 +27,14 @@ class SoilScene {
     if (c < 0 || r < 0 || c >= height_.cols || r >= height_.rows) return soil_z_;
     return soil_z_ - height_.at<float>(r, c);
   }
-  // Depth of the soil alone (without residue) at (x, y): the ground truth.
+  // Depth of the soil alone (without residue) at (x, y).
   float soil_z(double x, double y) const;
+  // Height of the ground's shape (tilt, ridges, layers; no micro-relief) above the datum
+  // at (x, y): what the ground truth follows.
+  double ground_height_mm(double x, double y) const;
+  // How much residue stands around (x, y): its height above the soil, averaged over about
+  // 10 mm (what multipath in a ToF pixel there sees).
+  float clutter_mm(double x, double y) const;
   Material material(double x, double y) const;
   cv::Vec3f albedo(double x, double y) const;  // BGR reflectance, 0..1
   // The nearest surface depth anywhere: rays start marching just above it.
@@ -37,10 +43,11 @@ class SoilScene {
  private:
   int cell_x(double x) const { return static_cast<int>(std::floor((x - area_.x) / cell_mm_)); }
   int cell_y(double y) const { return static_cast<int>(std::floor((y - area_.y) / cell_mm_)); }
-  void add_soil(const ScenePreset& preset, cv::RNG& rng);
-  void add_stubble(const ScenePreset& preset, cv::RNG& rng);
-  void add_straws(const ScenePreset& preset, cv::RNG& rng);
+  void add_soil(cv::RNG& rng);
+  void add_stubble(cv::RNG& rng);
+  void add_straws(cv::RNG& rng);
 
+  const ScenePreset preset_;
   float soil_z_;
   cv::Rect2d area_;
   double cell_mm_;
@@ -48,6 +55,7 @@ class SoilScene {
   cv::Mat height_;       // CV_32F, mm above the datum: soil and residue
   cv::Mat material_;     // CV_8U, Material
   cv::Mat albedo_;       // CV_8UC3, BGR reflectance * 255
+  cv::Mat clutter_;      // CV_32F, mm: residue height above the soil, blurred
   float top_z_;
 };
 

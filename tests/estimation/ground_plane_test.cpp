@@ -160,9 +160,9 @@ TEST(GroundPlane, TooFewPointsOnThePlaneIsInvalid) {
   const GroundDistance out = fit_plane(depth);
   EXPECT_FALSE(out.valid);
   EXPECT_EQ(out.distance_mm, 0.0);
-  EXPECT_TRUE(out.invalid_reason.starts_with("no plane fits the soil: 3")) << out.invalid_reason;
+  EXPECT_TRUE(out.invalid_reason.starts_with("no surface fits the soil: 3")) << out.invalid_reason;
   EXPECT_TRUE(out.invalid_reason.ends_with(
-      " % of the soil points lie within 10.0 mm of the best plane < 50.0 %"))
+      " % of the soil points (by weight) lie within 10.0 mm of the best one < 50.0 %"))
       << out.invalid_reason;
 }
 
