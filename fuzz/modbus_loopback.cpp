@@ -1,5 +1,6 @@
 #include "modbus_loopback.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -16,6 +17,8 @@
 
 namespace tilth::fuzz {
 namespace {
+
+using Clock = std::chrono::steady_clock;
 
 sockaddr_in ipv4(std::uint32_t address, int port) {
   sockaddr_in result{};
@@ -59,15 +62,40 @@ int free_loopback_port() {
   return ntohs(address.sin_port);
 }
 
-void connect_from(const Socket& socket, std::uint32_t source, int port) {
+// Whether the socket has one of `events` before `deadline`. A signal does not end the wait:
+// libFuzzer's -timeout sends SIGALRM every few seconds, with a handler installed without
+// SA_RESTART, and poll() then returns EINTR however long it has waited.
+bool ready_before(const Socket& socket, short events, Clock::time_point deadline) {
+  for (;;) {
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
+    pollfd polled{socket.fd(), events, 0};
+    const int ready = ::poll(&polled, 1, static_cast<int>(std::max<std::int64_t>(left.count(), 0)));
+    if (ready != -1) return ready == 1;
+    if (errno != EINTR)
+      throw Error(std::string("poll on a client connection failed: ") + std::strerror(errno));
+  }
+}
+
+void connect_from(const Socket& socket, std::uint32_t source, int port,
+                  Clock::time_point deadline) {
   const sockaddr_in from = ipv4(source, 0);
   const sockaddr_in to = ipv4(INADDR_LOOPBACK, port);
+  const auto failed = [&](int error) {
+    return Error("cannot connect from " + address_text(from) + " to " + address_text(to) + ": " +
+                 std::strerror(error));
+  };
   if (socket.fd() == -1 ||
-      ::bind(socket.fd(), reinterpret_cast<const sockaddr*>(&from), sizeof from) != 0 ||
-      ::connect(socket.fd(), reinterpret_cast<const sockaddr*>(&to), sizeof to) != 0) {
-    throw Error("cannot connect from " + address_text(from) + " to " + address_text(to) + ": " +
-                std::strerror(errno));
+      ::bind(socket.fd(), reinterpret_cast<const sockaddr*>(&from), sizeof from) != 0) {
+    throw failed(errno);
   }
+  if (::connect(socket.fd(), reinterpret_cast<const sockaddr*>(&to), sizeof to) == 0) return;
+  if (errno != EINTR) throw failed(errno);
+  // Interrupted by a signal, the connection goes on in the background.
+  if (!ready_before(socket, POLLOUT, deadline)) throw failed(ETIMEDOUT);
+  int error = 0;
+  socklen_t length = sizeof error;
+  ::getsockopt(socket.fd(), SOL_SOCKET, SO_ERROR, &error, &length);
+  if (error != 0) throw failed(error);
 }
 
 // The server may close the connection before it has read everything (bytes that are
@@ -75,6 +103,7 @@ void connect_from(const Socket& socket, std::uint32_t source, int port) {
 void send_all(const Socket& socket, std::span<const std::uint8_t> bytes) {
   for (std::size_t sent = 0; sent < bytes.size();) {
     const ssize_t n = ::send(socket.fd(), bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+    if (n == -1 && errno == EINTR) continue;
     if (n <= 0) return;
     sent += static_cast<std::size_t>(n);
   }
@@ -104,28 +133,31 @@ LoopbackModbusServer::LoopbackModbusServer(modbus::ServerOptions options) {
 
 HalfCloseOutcome half_close_session(std::uint32_t source, int port,
                                     std::span<const std::uint8_t> request,
-                                    std::chrono::milliseconds close_timeout,
+                                    std::chrono::milliseconds timeout,
                                     std::size_t max_reply_bytes) {
   const Socket socket;
-  connect_from(socket, source, port);
+  connect_from(socket, source, port, Clock::now() + timeout);
   send_all(socket, request);
   ::shutdown(socket.fd(), SHUT_WR);
 
+  const auto half_closed = Clock::now();
   HalfCloseOutcome outcome;
   while (outcome.replies.size() <= max_reply_bytes) {
-    pollfd polled{socket.fd(), POLLIN, 0};
-    if (::poll(&polled, 1, static_cast<int>(close_timeout.count())) != 1) {
+    if (!ready_before(socket, POLLIN, half_closed + timeout)) {
       outcome.tcp_state = tcp_state(socket);
-      return outcome;
+      break;
     }
     std::uint8_t buffer[4096];
     const ssize_t n = ::recv(socket.fd(), buffer, sizeof buffer, 0);
+    if (n == -1 && errno == EINTR) continue;
     if (n <= 0) {  // closed (or reset after the bytes it refused)
       outcome.closed = true;
-      return outcome;
+      break;
     }
     outcome.replies.insert(outcome.replies.end(), buffer, buffer + n);
   }
+  outcome.waited =
+      std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - half_closed);
   return outcome;
 }
 

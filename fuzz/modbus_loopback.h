@@ -31,18 +31,19 @@ class LoopbackModbusServer {
 };
 
 struct HalfCloseOutcome {
-  std::vector<std::uint8_t> replies;  // every byte the server sent, up to the limit
-  bool closed = false;                // the server closed the connection (FIN or RST)
-  unsigned tcp_state = 0;             // the client's TCP state (tcp_info) when not closed
+  std::vector<std::uint8_t> replies;   // every byte the server sent, up to the limit
+  bool closed = false;                 // the server closed the connection (FIN or RST)
+  unsigned tcp_state = 0;              // the client's TCP state (tcp_info) when not closed
+  std::chrono::milliseconds waited{};  // from the half-close to the close or the deadline
 };
 
 // Connects from `source` (an IPv4 loopback address, host byte order) to the server on
 // 127.0.0.1:`port`, sends `request`, closes its sending side and reads every reply until
-// the server closes, `close_timeout` passes or more than `max_reply_bytes` arrived.
-// Throws tilth::Error when it cannot connect.
+// the server closes, `timeout` has passed since the half-close, or more than
+// `max_reply_bytes` arrived. Signals (libFuzzer's SIGALRM) interrupt none of the waits.
+// Throws tilth::Error when it cannot connect within `timeout`.
 HalfCloseOutcome half_close_session(std::uint32_t source, int port,
                                     std::span<const std::uint8_t> request,
-                                    std::chrono::milliseconds close_timeout,
-                                    std::size_t max_reply_bytes);
+                                    std::chrono::milliseconds timeout, std::size_t max_reply_bytes);
 
 }  // namespace tilth::fuzz
