@@ -2,18 +2,13 @@
 // only reachable through a socket (its framing, checks and replies live in its poll
 // thread), so it runs here as in a graph, on a free loopback port, and each input is
 // the byte stream of one client connection: connect, send the input, close the sending
-// side, read every reply until the server closes. A bug is a crash or sanitizer report
-// in the server thread, a connection the server does not close after the client's end
-// of stream, or a reply that is not a whole Modbus TCP frame answering the request at
-// the same position (same transaction id and unit, same function code or the exception
-// to it).
+// side, read every reply until the server closes (fuzz/modbus_loopback.h). A bug is a
+// crash or sanitizer report in the server thread, a connection the server has not closed
+// 5 s after the client's end of stream (a wait that libFuzzer's SIGALRM does not cut
+// short), or a reply that is not a whole Modbus TCP frame answering the request at the
+// same position (same transaction id and unit, same function code or the exception to
+// it).
 #include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
-#include <arpa/inet.h>
 
 #include <chrono>
 #include <cstddef>
@@ -21,22 +16,22 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <memory>
+#include <span>
 #include <vector>
 
-#include "latest_measurement.h"
-#include "modbus_server.h"
+#include "modbus_loopback.h"
 #include "tilth/error.h"
 #include "tilth/log.h"
 
 namespace {
 
-using tilth::modbus::LatestMeasurement;
-using tilth::modbus::ModbusServer;
-using tilth::modbus::ServerOptions;
+using tilth::fuzz::half_close_session;
+using tilth::fuzz::LoopbackModbusServer;
 
 constexpr std::size_t kMbapSize = 7;
-constexpr int kCloseTimeoutMs = 10000;
+// Within libFuzzer's -timeout (10 s in fuzz/run.sh), so that the target's own report, with
+// the connection's TCP state, is the one made.
+constexpr std::chrono::milliseconds kCloseTimeout{5000};
 constexpr std::size_t kMaxReplyBytes = 1 << 16;
 
 [[noreturn]] void fail(const char* what) {
@@ -44,50 +39,18 @@ constexpr std::size_t kMaxReplyBytes = 1 << 16;
   std::abort();
 }
 
-sockaddr_in loopback(int port) {
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<std::uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  return address;
-}
-
-// A port nothing listens on now: the kernel's choice for a socket bound to port 0.
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address = loopback(0);
-  socklen_t length = sizeof address;
-  if (fd == -1 || ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
-    fail("cannot find a free loopback port");
+LoopbackModbusServer start_server() {
+  // The server logs every client it refuses; the fuzzer's output stays readable.
+  tilth::set_log_handler([](tilth::LogLevel, std::string_view, std::string_view) {});
+  tilth::modbus::ServerOptions options;
+  options.unit_id = 1;
+  options.base_register = 100;
+  try {
+    return LoopbackModbusServer(options);
+  } catch (const tilth::Error& error) {
+    fail(error.what());
   }
-  ::close(fd);
-  return ntohs(address.sin_port);
 }
-
-struct Server {
-  LatestMeasurement latest{std::chrono::milliseconds(500)};
-  int port = 0;
-  std::unique_ptr<ModbusServer> server;
-
-  Server() {
-    // The server logs every client it refuses; the fuzzer's output stays readable.
-    tilth::set_log_handler([](tilth::LogLevel, std::string_view, std::string_view) {});
-    for (int attempt = 0; attempt < 5 && !server; ++attempt) {
-      ServerOptions options;
-      options.address = "127.0.0.1";
-      options.port = free_port();
-      options.unit_id = 1;
-      options.base_register = 100;
-      try {
-        server = std::make_unique<ModbusServer>(options, latest, tilth::Logger("fuzz"));
-        port = options.port;
-      } catch (const tilth::Error&) {  // the port was taken in between: another one
-      }
-    }
-    if (!server) fail("cannot start the Modbus server");
-  }
-};
 
 std::uint16_t word_at(const std::vector<std::uint8_t>& bytes, std::size_t offset) {
   return static_cast<std::uint16_t>(bytes[offset] << 8 | bytes[offset + 1]);
@@ -109,47 +72,30 @@ std::vector<std::vector<std::uint8_t>> frames_of(const std::vector<std::uint8_t>
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const Server server;
+  static const LoopbackModbusServer server = start_server();
   // The client closes first, so each connection leaves a TIME_WAIT (60 s) behind on its
   // side: thousands a second would use up one address's ephemeral ports in seconds. The
   // client therefore connects from the 253 loopback addresses 127.0.0.2 to 127.0.0.254
   // in turn.
   static std::uint32_t connections = 0;
-  sockaddr_in source = loopback(0);
-  source.sin_addr.s_addr = htonl(INADDR_LOOPBACK + 1 + connections++ % 253);
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  const sockaddr_in address = loopback(server.port);
-  if (fd == -1 || ::bind(fd, reinterpret_cast<const sockaddr*>(&source), sizeof source) != 0 ||
-      ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-    fail("cannot connect to the server");
+  const std::uint32_t source = INADDR_LOOPBACK + 1 + connections++ % 253;
+  tilth::fuzz::HalfCloseOutcome outcome;
+  try {
+    outcome = half_close_session(source, server.port(), std::span(data, size), kCloseTimeout,
+                                 kMaxReplyBytes);
+  } catch (const tilth::Error& error) {
+    fail(error.what());
   }
-  // The server may close the connection before it has read everything (bytes that are
-  // not Modbus TCP): a failed send is the client's loss, not a bug.
-  for (std::size_t sent = 0; sent < size;) {
-    const ssize_t n = ::send(fd, data + sent, size - sent, MSG_NOSIGNAL);
-    if (n <= 0) break;
-    sent += static_cast<std::size_t>(n);
+  const std::vector<std::uint8_t>& replies = outcome.replies;
+  if (replies.size() > kMaxReplyBytes) fail("more reply bytes than requests could ask for");
+  if (!outcome.closed) {
+    std::fprintf(stderr,
+                 "modbus_request: after %zu bytes sent and %zu received, TCP state %u %lld ms "
+                 "after the half-close\n",
+                 size, replies.size(), outcome.tcp_state,
+                 static_cast<long long>(outcome.waited.count()));
+    fail("the server kept the connection open");
   }
-  ::shutdown(fd, SHUT_WR);
-
-  std::vector<std::uint8_t> replies;
-  for (;;) {
-    pollfd polled{fd, POLLIN, 0};
-    if (::poll(&polled, 1, kCloseTimeoutMs) != 1) {
-      tcp_info info{};
-      socklen_t length = sizeof info;
-      ::getsockopt(fd, IPPROTO_TCP, TCP_INFO, &info, &length);
-      std::fprintf(stderr, "modbus_request: after %zu bytes sent and %zu received, TCP state %u\n",
-                   size, replies.size(), static_cast<unsigned>(info.tcpi_state));
-      fail("the server kept the connection open");
-    }
-    std::uint8_t buffer[4096];
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
-    if (n <= 0) break;  // closed (or reset after the bytes it refused)
-    replies.insert(replies.end(), buffer, buffer + n);
-    if (replies.size() > kMaxReplyBytes) fail("more reply bytes than requests could ask for");
-  }
-  ::close(fd);
 
   const auto requests = frames_of(std::vector<std::uint8_t>(data, data + size));
   const auto answers = frames_of(replies);
