@@ -102,6 +102,21 @@ std::optional<Plane> ransac(const std::vector<Point>& points) {
   return best;
 }
 
+// The RANSAC plane through the depths of every kSampleStepPx-th supported pixel, unless
+// too few are supported.
+std::optional<Plane> farthest_plane(const cv::Mat& depth, const cv::Mat& support) {
+  thread_local std::vector<Point> points;
+  points.clear();
+  for (int row = kSampleStepPx / 2; row < depth.rows; row += kSampleStepPx) {
+    const auto* d = depth.ptr<float>(row);
+    const auto* soil = support.ptr<std::uint8_t>(row);
+    for (int col = kSampleStepPx / 2; col < depth.cols; col += kSampleStepPx) {
+      if (soil[col] != 0) points.push_back({double(col), double(row), d[col]});
+    }
+  }
+  return points.size() < kMinPoints ? std::nullopt : ransac(points);
+}
+
 // The envelope on the half-resolution grid: a morphological closing of the depth of the
 // pixels that may be soil (the farthest depth within the window, then the nearest of
 // those). Residue narrower than the window is gone from it; ground that slopes, curves
@@ -183,19 +198,10 @@ void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
   cv::bitwise_or(no_depth, missing, no_depth);
   cv::bitwise_and(candidates, ~no_depth, support);
 
-  thread_local std::vector<Point> points;
-  points.clear();
-  for (int row = kSampleStepPx / 2; row < depth.rows; row += kSampleStepPx) {
-    const auto* d = depth.ptr<float>(row);
-    const auto* soil = support.ptr<std::uint8_t>(row);
-    for (int col = kSampleStepPx / 2; col < depth.cols; col += kSampleStepPx) {
-      if (soil[col] != 0) points.push_back({double(col), double(row), d[col]});
-    }
-  }
   if (envelope_px_ > 0) {
     follow_relief(std::nullopt, envelope_px_, depth, support, height_mm_, surface_px_, surface);
   } else {
-    const std::optional<Plane> plane = points.size() < kMinPoints ? std::nullopt : ransac(points);
+    const std::optional<Plane> plane = farthest_plane(depth, support);
     height_mm.create(depth_mm.size(), CV_32FC1);
     if (!plane) {
       height_mm.setTo(kNaN);
