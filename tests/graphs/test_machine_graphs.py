@@ -48,6 +48,9 @@ def wait_for_port(port, process=None, timeout=90.0):
             return
         except OSError:
             time.sleep(0.05)
+    if process is not None and process.poll() is not None:
+        raise AssertionError("nothing listened on port %d before the run ended (exit %d): %s"
+                             % (port, process.returncode, process.communicate(timeout=60)[1]))
     raise AssertionError("nothing listens on port %d" % port)
 
 
