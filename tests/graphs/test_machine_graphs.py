@@ -5,22 +5,22 @@ to the simulator's truth, and a real Modbus peer (pymodbus) reads, or receives, 
 same values the CSV has for the frame the frame counter names.
 """
 import csv
-import math
 import os
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
 
-sys.path.insert(0, os.environ["MODBUS_TEST_DIR"])
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
 from pymodbus_tcp import ModbusTcpClient  # noqa: E402
+from ports import free_port, wait_for_port  # noqa: E402
 from pymodbus.exceptions import ConnectionException  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 GRAPHS = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs")
-PLC_SERVER = os.path.join(os.environ["MODBUS_TEST_DIR"], "plc_server.py")
+PLC_SERVER = os.path.join(SUPPORT, "plc_server.py")
 
 FRAMES = 40
 FPS = 10  # slow enough that several Modbus reads fall inside the run
@@ -30,28 +30,6 @@ FRAME_REGISTER, STATUS_REGISTER, VALID = 4, 6, 1
 # 4 mm relief, a plane read at a tool point, and a trimmed mean on heavy residue leave a
 # few mm between "the" soil surface and the one measured.
 TOLERANCE_MM = {"seeder": 1.0, "transplanter": 6.0, "tillage": 4.0}
-
-
-def free_port():
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def wait_for_port(port, process=None, timeout=90.0):
-    """Until something listens on `port` (the simulator builds its scene first, which
-    takes seconds on a loaded machine), or `process` ends."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and (process is None or process.poll() is None):
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
-            return
-        except OSError:
-            time.sleep(0.05)
-    if process is not None and process.poll() is not None:
-        raise AssertionError("nothing listened on port %d before the run ended (exit %d): %s"
-                             % (port, process.returncode, process.communicate(timeout=60)[1]))
-    raise AssertionError("nothing listens on port %d" % port)
 
 
 def words_to_int32(high, low):

@@ -27,12 +27,15 @@ import threading
 import time
 import unittest
 
-from pymodbus_tcp import ModbusTcpClient
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from pymodbus_tcp import ModbusTcpClient  # noqa: E402
+from ports import free_port, wait_for_port  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 PLUGIN_DIR = os.environ["TILTH_TEST_PLUGIN_DIR"]
 MBPOLL = os.environ["MBPOLL"]
-PLC_SERVER = os.environ["PLC_SERVER"]
+PLC_SERVER = os.path.join(SUPPORT, "plc_server.py")
 CROWD = os.environ["CROWD"]
 
 # The register map (docs/modbus.md), offsets from base_register.
@@ -46,23 +49,6 @@ STALE_TIMEOUT_MS = 200
 FRAMES = 60
 FIRST_FRAME_ID = 65500  # the frame counter's high word changes during the run
 INVALID_EVERY = 7
-
-
-def free_port():
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def wait_for_port(port, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
-            return
-        except OSError:
-            time.sleep(0.05)
-    raise AssertionError("nothing listens on port %d" % port)
 
 
 class TilthRun:
