@@ -1,8 +1,8 @@
-// The measurement chain on one core: depth.projection -> registration.projective ->
-// segmentation.color_threshold -> estimation.ground_distance with the parameters of
-// graphs/measurement-chain.json and the paper's rig, on one frame pair (640x480 depth,
-// 1280x1024 colour) rendered by synthetic.scene (preset case_c), in ms per frame pair;
-// and each stage alone on the same frame.
+// The measurement chain on one core: its four nodes (project -> register -> segment ->
+// estimate) with the types and parameters of graphs/measurement-chain.json (or of the
+// chain file TILTH_CHAIN_GRAPH names) and the paper's rig, on one frame pair (640x480
+// depth, 1280x1024 colour) rendered by synthetic.scene (preset case_c), in ms per frame
+// pair; and each stage alone on the same frame.
 //
 // allocs_per_frame counts the heap allocations of a frame in the steady state: global
 // operator new / new[] (replaced below) and cv::Mat buffers (which OpenCV takes from
@@ -11,9 +11,11 @@
 #include <array>
 #include <atomic>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <new>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -87,6 +89,19 @@ StageInstance make(const std::string& type, nlohmann::json params = nlohmann::js
   return registry().create(type, StageContext{type, Params(params), Logger(type), {}});
 }
 
+// The node `name` of the chain file, its parameters completed as `make` does.
+StageInstance chain_node(const std::string& name) {
+  static const nlohmann::json nodes = [] {
+    const char* const chosen = std::getenv("TILTH_CHAIN_GRAPH");
+    const std::string path = chosen ? chosen : TILTH_SOURCE_DIR "/graphs/measurement-chain.json";
+    std::ifstream file(path);
+    if (!file) throw std::runtime_error("cannot read the chain file " + path);
+    return nlohmann::json::parse(file, nullptr, true, /*ignore_comments=*/true).at("nodes");
+  }();
+  const nlohmann::json& node = nodes.at(name);
+  return make(node.at("type"), node.value("params", nlohmann::json::object()));
+}
+
 // One frame pair (raw ToF, colour) of the simulator's case_c in `color_format`, rendered
 // once per format.
 const std::array<Packet, 2>& scene_frame(const std::string& color_format) {
@@ -107,7 +122,7 @@ void process(StageInstance& stage, std::span<const Packet> inputs, std::span<Pac
   dynamic_cast<Transform&>(*stage.stage).process(frame);
 }
 
-// The four stages with the parameters of graphs/measurement-chain.json, and the packets of
+// The four stages of the chain file, and the packets of
 // one frame, held here so that running a frame itself allocates nothing.
 class Chain {
  public:
@@ -151,10 +166,10 @@ class Chain {
   }
 
  private:
-  StageInstance project_ = make("depth.projection");
-  StageInstance register_ = make("registration.projective");
-  StageInstance segment_ = make("segmentation.color_threshold", {{"speckle_px", 1}});
-  StageInstance estimate_ = make("estimation.ground_distance");
+  StageInstance project_ = chain_node("project");
+  StageInstance register_ = chain_node("register");
+  StageInstance segment_ = chain_node("segment");
+  StageInstance estimate_ = chain_node("estimate");
   const std::array<Packet, 2> pair_;
   std::array<Packet, 1> depth_;
   std::array<Packet, 2> register_in_;

@@ -72,7 +72,7 @@ class GroundDistanceEstimator final : public Transform {
   enum Port { kSoilDepth = 0, kColor = 1 };
 
   explicit GroundDistanceEstimator(const StageContext& context)
-      : region_(context.params.json("roi")),
+      : region_(context.params.json("roi"), RegionOfInterest::Whole::kMiddleHalf),
         statistic_(context.params.string("statistic") == "median" ? Statistic::kMedian
                                                                   : Statistic::kTrimmedMean),
         trim_fraction_(context.params.number("trim_fraction")),
@@ -182,7 +182,7 @@ StageDescriptor describe_ground_distance() {
   d.outputs = {PortSpec::of<GroundDistance>(
       "distance", "distance, validity, soil fraction, spread (1.4826 MAD), confidence")};
   d.params = {
-      roi_param(),
+      roi_param(RegionOfInterest::Whole::kMiddleHalf),
       ParamSpec::choice("statistic", {"median", "trimmed_mean"}, "median")
           .describe("how the soil depths become one distance"),
       ParamSpec::number("trim_fraction", 0.2)

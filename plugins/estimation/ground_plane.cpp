@@ -55,8 +55,10 @@ namespace {
 
 // A bound only: re-fitting stops as soon as the inlier set no longer changes.
 constexpr int kMaxRefits = 10;
+constexpr std::size_t kScoreStep = 4;
 // Points farther than 3.7 neighbourhoods from the tool point are left out of the fit.
 constexpr double kNegligibleWeight = 1e-3;
+const double kNegligibleExponent = -std::log(kNegligibleWeight);
 // Any fixed value: the same frame always gives the same surface.
 constexpr std::uint32_t kRansacSeed = 20240611;
 
@@ -164,7 +166,8 @@ std::optional<Surface> refine(const std::vector<SoilPoint>& points, Surface plan
 }
 
 // Planes through three points drawn in proportion to their weight, scored by the weight of
-// their inliers.
+// their inliers among every kScoreStep-th point (a sample as good as all of them for
+// ranking the hypotheses: the best is refined on all).
 std::optional<Surface> ransac(const std::vector<SoilPoint>& points, int hypotheses,
                               double threshold_mm) {
   thread_local std::vector<double> cumulative;
@@ -186,8 +189,8 @@ std::optional<Surface> ransac(const std::vector<SoilPoint>& points, int hypothes
     const auto plane = Surface::through(p, q, r);
     if (!plane) continue;
     double weight = 0.0;
-    for (const SoilPoint& point : points) {
-      if (plane->inlier(point, threshold_mm)) weight += point.weight;
+    for (std::size_t i = 0; i < points.size(); i += kScoreStep) {
+      if (plane->inlier(points[i], threshold_mm)) weight += points[i].weight;
     }
     if (weight > best_weight) {
       best = plane;
@@ -244,7 +247,7 @@ class GroundPlaneEstimator final : public Transform {
   enum Port { kSoilDepth = 0, kColor = 1 };
 
   explicit GroundPlaneEstimator(const StageContext& context)
-      : region_(context.params.json("roi")),
+      : region_(context.params.json("roi"), RegionOfInterest::Whole::kMiddleHalf),
         tool_point_mm_(parse_tool_point(context.params.json("tool_point"))),
         requirement_(soil_requirement(context.params)),
         threshold_mm_(context.params.number("outlier_threshold_mm")),
@@ -362,11 +365,13 @@ class GroundPlaneEstimator final : public Transform {
 
   // A Gaussian (sigma `scale_mm`) of a point's distance across the ground from the tool
   // point; 1 for every point when the scale is 0.
+  // Below kNegligibleWeight it is 0, without computing the exponential.
   double nearness(double x_mm, double y_mm, double scale_mm) const {
     if (scale_mm <= 0) return 1.0;
     const double dx = x_mm - tool_point_mm_[0];
     const double dy = y_mm - tool_point_mm_[1];
-    return std::exp(-(dx * dx + dy * dy) / (2 * scale_mm * scale_mm));
+    const double exponent = (dx * dx + dy * dy) / (2 * scale_mm * scale_mm);
+    return exponent > kNegligibleExponent ? 0.0 : std::exp(-exponent);
   }
 
   // Up to max_surfaces surfaces, each fitted (RANSAC, then least squares) to the soil
@@ -426,7 +431,7 @@ StageDescriptor describe_ground_plane() {
       "distance", "distance at the tool point, tilt, validity, spread (inlier RMS), confidence")};
   d.params = {
       frame_calibration_param(),
-      roi_param(),
+      roi_param(RegionOfInterest::Whole::kMiddleHalf),
       ParamSpec::json("tool_point", nlohmann::json::array({0.0, 0.0}))
           .in_unit("mm")
           .describe("[x, y] in the ToF camera frame where the distance is read; [0, 0] = axis"),

@@ -20,13 +20,17 @@ struct ColorEvidence {
   std::int64_t with_depth = 0;  // pixels whose colour registration could look up
   std::int64_t pixels = 0;
   std::int64_t clipped = 0;  // white or black in every channel
-  double gray_sum = 0.0;
-  double gray_squares = 0.0;
+  // Of the channel sums (three times the gray), in integers: exact, and a short chain of
+  // dependent additions per pixel.
+  std::int64_t channel_sum = 0;
+  std::int64_t channel_sum_squares = 0;
 
   double clipped_fraction() const { return static_cast<double>(clipped) / pixels; }
   double gray_deviation() const {
-    const double mean = gray_sum / pixels;
-    return std::sqrt(std::max(0.0, gray_squares / pixels - mean * mean));
+    const double n = static_cast<double>(pixels);
+    const double mean = static_cast<double>(channel_sum) / (3 * n);
+    const double mean_square = static_cast<double>(channel_sum_squares) / (9 * n);
+    return std::sqrt(std::max(0.0, mean_square - mean * mean));
   }
 };
 
@@ -49,9 +53,9 @@ ColorEvidence evidence_in(const RegisteredColor& color, cv::Rect roi) {
       const int low = std::min({pixel[0], pixel[1], pixel[2]});
       const int high = std::max({pixel[0], pixel[1], pixel[2]});
       seen.clipped += (low >= kClippedWhite || high <= kClippedBlack) ? 1 : 0;
-      const double gray = (pixel[0] + pixel[1] + pixel[2]) / 3.0;
-      seen.gray_sum += gray;
-      seen.gray_squares += gray * gray;
+      const int sum = pixel[0] + pixel[1] + pixel[2];
+      seen.channel_sum += sum;
+      seen.channel_sum_squares += sum * sum;
       ++seen.pixels;
     }
   }

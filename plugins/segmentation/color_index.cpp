@@ -31,11 +31,12 @@ class ColorIndexStage final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    const ResidueInputs in = read_residue_inputs(
+        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
     thread_local cv::Mat residue;
-    const IndexSplit split = index_.classify(in.color.bgr, in.untrusted, residue);
+    const IndexSplit split = index_.classify(in.bgr, in.untrusted, residue);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());
-    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
+    output_.emit(frame, in.area, residue, in.untrusted, in.unknown, in.depth_mm);
   }
 
  private:
@@ -54,8 +55,8 @@ StageDescriptor describe_color_index() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(), smoothing_px_param(), dilation_px_param(),
-      speckle_px_param(1), min_value_param(),
+      color_index_param(),   smoothing_px_param(), dilation_px_param(),
+      segmented_roi_param(), speckle_px_param(1),  min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<ColorIndexStage>();

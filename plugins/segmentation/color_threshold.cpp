@@ -139,10 +139,13 @@ class ColorThreshold final : public Transform {
     const auto& color = frame.input<RegisteredColor>(kColorInput);
     const auto& depth = frame.input<DepthImage>(kDepthInput);
     check_residue_inputs(color, depth);
+    const cv::Rect area = output_.area(depth.mm.size());
     thread_local Scratch scratch;
-    min_value_ > 0 ? classify<true>(color, scratch) : classify<false>(color, scratch);
+    const cv::Mat bgr = color.bgr(area);
+    const cv::Mat status = color.status(area);
+    min_value_ > 0 ? classify<true>(bgr, status, scratch) : classify<false>(bgr, status, scratch);
     // Pixels without depth are unknown too: emit finds them as it writes the soil depth.
-    output_.emit(frame, scratch.residue, scratch.untrusted, depth.mm);
+    output_.emit(frame, area, scratch.residue, scratch.untrusted, depth.mm(area));
   }
 
  private:
@@ -150,15 +153,15 @@ class ColorThreshold final : public Transform {
   // colour may fall in the range by chance (an occluded pixel carries the colour of what
   // hides it); it must not grow into its neighbours.
   template <bool kCheckDark>
-  void classify(const RegisteredColor& color, Scratch& scratch) const {
-    const int rows = color.bgr.rows;
-    const int cols = color.bgr.cols;
+  void classify(const cv::Mat& bgr_image, const cv::Mat& status_image, Scratch& scratch) const {
+    const int rows = bgr_image.rows;
+    const int cols = bgr_image.cols;
     scratch.residue.resize(rows, cols);
     scratch.untrusted.resize(rows, cols);
     scratch.dark.resize(kCheckDark ? static_cast<std::size_t>(cols) : 0);
     std::uint8_t* const dark = scratch.dark.data();
     for (int y = 0; y < rows; ++y) {
-      const auto* bgr = color.bgr.ptr<std::uint8_t>(y);
+      const auto* bgr = bgr_image.ptr<std::uint8_t>(y);
       std::uint64_t* residue = scratch.residue.row(y);
       residue_colors_.classify_row(kernels_, bgr, cols, residue);
       if constexpr (kCheckDark) {
@@ -167,7 +170,7 @@ class ColorThreshold final : public Transform {
           dark[x] = std::max({pixel[0], pixel[1], pixel[2]}) < min_value_ ? 255 : 0;
         }
       }
-      const auto* status = color.status.ptr<std::uint8_t>(y);
+      const auto* status = status_image.ptr<std::uint8_t>(y);
       std::uint64_t* untrusted = scratch.untrusted.row(y);
       for (int x = 0; x < cols; x += 64) {
         const int count = std::min(64, cols - x);
@@ -205,6 +208,7 @@ StageDescriptor describe_color_threshold() {
           .describe("highest residue colour [c0, c1, c2], inclusive; null = hsv [40, 255, 255], "
                     "lab [255, 132, 255], bgr [255, 255, 255]"),
       dilation_px_param(),
+      segmented_roi_param(),
       speckle_px_param(0),
       min_value_param(),
   };

@@ -32,14 +32,16 @@ class DepthAided final : public Transform {
     const auto& color = frame.input<RegisteredColor>(kColorInput);
     const auto& depth = frame.input<DepthImage>(kDepthInput);
     check_residue_inputs(color, depth);
+    const cv::Rect area = output_.area(depth.mm.size());
+    const cv::Mat depth_mm = depth.mm(area);
 
     thread_local cv::Mat missing, height, residue, unknown;
-    mark_missing_depth(depth.mm, missing);
-    surface_.heights(depth.mm, missing, ~missing, height);
+    mark_missing_depth(depth_mm, missing);
+    surface_.heights(depth_mm, missing, ~missing, height);
     cv::compare(height, height_mm_, residue, cv::CMP_GT);  // NaN: no
     cv::compare(height, height, unknown, cv::CMP_NE);      // NaN: no surface near
     cv::bitwise_or(unknown, missing, unknown);
-    output_.emit(frame, residue, unknown, unknown, depth.mm);
+    output_.emit(frame, area, residue, unknown, unknown, depth_mm);
   }
 
  private:
@@ -56,8 +58,8 @@ StageDescriptor describe_depth_aided() {
   d.summary = "residue mask from the height above a robust soil surface (depth only)";
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
-  d.params = {height_mm_param(), surface_px_param(), envelope_px_param(), dilation_px_param(),
-              speckle_px_param(1)};
+  d.params = {height_mm_param(),   surface_px_param(),    envelope_px_param(),
+              dilation_px_param(), segmented_roi_param(), speckle_px_param(1)};
   d.concurrency = Concurrency::kParallel;
   d.create = factory<DepthAided>();
   return d;

@@ -40,20 +40,21 @@ class Fusion final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    const ResidueInputs in = read_residue_inputs(
+        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
     thread_local cv::Mat by_color, soil_color, height, by_height, unknown;
-    const IndexSplit split = index_.classify(in.color.bgr, in.untrusted, by_color);
+    const IndexSplit split = index_.classify(in.bgr, in.untrusted, by_color);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());
     cv::subtract(by_color, in.untrusted, by_color);
     cv::bitwise_or(by_color, in.unknown, soil_color);
     cv::bitwise_not(soil_color, soil_color);
 
-    surface_.heights(in.depth.mm, in.missing, soil_color, height);
+    surface_.heights(in.depth_mm, in.missing, soil_color, height);
     cv::compare(height, height_mm_, by_height, cv::CMP_GT);  // NaN: no
     cv::bitwise_or(by_color, by_height, by_color);
     cv::compare(height, height, unknown, cv::CMP_NE);  // NaN: no surface, no height cue
     cv::bitwise_or(unknown, in.unknown, unknown);
-    output_.emit(frame, by_color, cv::Mat(), unknown, in.depth.mm);
+    output_.emit(frame, in.area, by_color, cv::Mat(), unknown, in.depth_mm);
   }
 
  private:
@@ -74,8 +75,9 @@ StageDescriptor describe_fusion() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(), smoothing_px_param(), height_mm_param(),   surface_px_param(),
-      envelope_px_param(), dilation_px_param(),  speckle_px_param(1), min_value_param(),
+      color_index_param(),   smoothing_px_param(), height_mm_param(),
+      surface_px_param(),    envelope_px_param(),  dilation_px_param(),
+      segmented_roi_param(), speckle_px_param(1),  min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<Fusion>();

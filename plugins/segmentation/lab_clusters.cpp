@@ -143,10 +143,11 @@ class LabClusters final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    const ResidueInputs in = read_residue_inputs(
+        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
     thread_local cv::Mat features, residue;
     thread_local std::vector<cv::Vec2f> sample;
-    chroma_features(in.color.bgr, smoothing_px_, features);
+    chroma_features(in.bgr, smoothing_px_, features);
 
     sample.clear();
     for (int row = 0; row < features.rows; row += kSampleStepPx) {
@@ -171,7 +172,7 @@ class LabClusters final : public Transform {
         out[col] = boundary.residue(feature[col]) ? ResidueMask::kResidue : ResidueMask::kSoil;
       }
     }
-    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
+    output_.emit(frame, in.area, residue, in.untrusted, in.unknown, in.depth_mm);
   }
 
  private:
@@ -190,10 +191,8 @@ StageDescriptor describe_lab_clusters() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      smoothing_px_param(),
-      dilation_px_param(),
-      speckle_px_param(1),
-      min_value_param(),
+      smoothing_px_param(), dilation_px_param(), segmented_roi_param(),
+      speckle_px_param(1),  min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<LabClusters>();

@@ -30,16 +30,17 @@ class PixelClassifier final : public Transform {
         output_(context.params) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(frame, min_value_);
+    const ResidueInputs in = read_residue_inputs(
+        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
     thread_local cv::Mat cells, residue;
-    color_cells(in.color.bgr, cells);
+    color_cells(in.bgr, cells);
     residue.create(cells.size(), CV_8UC1);
     for (int row = 0; row < cells.rows; ++row) {
       const auto* cell = cells.ptr<std::int32_t>(row);
       auto* out = residue.ptr<std::uint8_t>(row);
       for (int col = 0; col < cells.cols; ++col) out[col] = residue_by_cell_[cell[col]];
     }
-    output_.emit(frame, residue, in.untrusted, in.unknown, in.depth.mm);
+    output_.emit(frame, in.area, residue, in.untrusted, in.unknown, in.depth_mm);
   }
 
  private:
@@ -61,6 +62,7 @@ StageDescriptor describe_pixel_classifier() {
           .describe("model file written by tilth train-segmenter (" +
                     std::string(kClassifierFormat) + ")"),
       dilation_px_param(),
+      segmented_roi_param(),
       speckle_px_param(1),
       min_value_param(),
   };

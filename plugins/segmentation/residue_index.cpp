@@ -40,15 +40,13 @@ const IndexInfo& info(ColorIndex index) { return kIndices[static_cast<int>(index
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// One pixel's index from its (summed) B, G, R; NaN for black, and for grey in the hue
-// index.
+// One pixel's index from its (summed) B, G, R; NaN for black (0 / 0 in the ratios, which
+// thus need no branch and vectorise), and for grey in the hue index.
 template <ColorIndex kIndex>
 float index_of(float b, float g, float r) {
-  const float sum = b + g + r;
-  if (sum <= 0) return kNaN;
-  if constexpr (kIndex == ColorIndex::kExg) return (2 * g - r - b) / sum;
-  if constexpr (kIndex == ColorIndex::kExr) return (1.4f * r - g) / sum;
-  if constexpr (kIndex == ColorIndex::kExgr) return (3 * g - 2.4f * r - b) / sum;
+  if constexpr (kIndex == ColorIndex::kExg) return (2 * g - r - b) / (b + g + r);
+  if constexpr (kIndex == ColorIndex::kExr) return (1.4f * r - g) / (b + g + r);
+  if constexpr (kIndex == ColorIndex::kExgr) return (3 * g - 2.4f * r - b) / (b + g + r);
   // HSV hue in degrees, with red-magenta (above 300) taken as negative so that the
   // reds and browns of soil stay next to the yellows of straw: -60 .. 300.
   const float high = std::max({b, g, r});
@@ -69,8 +67,10 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
     const auto* skip = untrusted.ptr<std::uint8_t>(row);
     auto* out = index.ptr<float>(row);
     for (int col = 0; col < summed.cols; ++col) {
-      const float value = index_of<kIndex>(in[col][0], in[col][1], in[col][2]);
-      out[col] = value;
+      out[col] = index_of<kIndex>(in[col][0], in[col][1], in[col][2]);
+    }
+    for (int col = 0; col < summed.cols; ++col) {
+      const float value = out[col];
       if (skip[col] != 0 || std::isnan(value)) continue;
       const int bin = static_cast<int>((value - range.low) * bins_per_unit);
       ++histogram[std::clamp(bin, 0, kBins - 1)];

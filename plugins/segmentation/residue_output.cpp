@@ -1,6 +1,7 @@
 #include "residue_output.h"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -10,6 +11,11 @@
 
 namespace tilth::segmentation {
 namespace {
+
+// The farthest the outputs' last steps reach from a pixel: colour smoothing
+// (smoothing_px <= 3) or speckle removal and dilation (speckle_px + dilation_px), rounded
+// up to whole 8-pixel steps.
+constexpr int kReachPx = 8;
 
 std::string size_text(const cv::Mat& image) {
   return std::to_string(image.cols) + "x" + std::to_string(image.rows);
@@ -70,17 +76,20 @@ ParamSpec smoothing_px_param() {
       .describe("colours are averaged over a (2r+1)^2 box first; 0 = each pixel's own");
 }
 
+ParamSpec segmented_roi_param() { return roi_param(RegionOfInterest::Whole::kImage); }
+
 ParamSpec min_value_param() {
   return ParamSpec::integer("min_value", 0)
       .range(0, 255)
       .describe("pixels whose brightest channel is below this are unknown (deep shadow)");
 }
 
-void mark_untrusted_color(const RegisteredColor& color, int min_value, cv::Mat& untrusted) {
-  cv::compare(color.status, RegisteredColor::kValid, untrusted, cv::CMP_NE);
+void mark_untrusted_color(const cv::Mat& bgr, const cv::Mat& status, int min_value,
+                          cv::Mat& untrusted) {
+  cv::compare(status, RegisteredColor::kValid, untrusted, cv::CMP_NE);
   if (min_value == 0) return;
   thread_local cv::Mat dark;
-  cv::inRange(color.bgr, cv::Scalar::all(0), cv::Scalar::all(min_value - 1), dark);
+  cv::inRange(bgr, cv::Scalar::all(0), cv::Scalar::all(min_value - 1), dark);
   cv::bitwise_or(untrusted, dark, untrusted);
 }
 
@@ -90,23 +99,34 @@ void mark_missing_depth(const cv::Mat& depth_mm, cv::Mat& missing) {
   cv::bitwise_not(missing, missing);
 }
 
-ResidueInputs read_residue_inputs(const Frame& frame, int min_value) {
+ResidueInputs read_residue_inputs(const Frame& frame, int min_value, const cv::Rect& area) {
   const auto& color = frame.input<RegisteredColor>(kColorInput);
   const auto& depth = frame.input<DepthImage>(kDepthInput);
   check_residue_inputs(color, depth);
+  const cv::Mat bgr = color.bgr(area);
+  const cv::Mat depth_mm = depth.mm(area);
   thread_local cv::Mat untrusted, missing, unknown;
-  mark_untrusted_color(color, min_value, untrusted);
-  mark_missing_depth(depth.mm, missing);
+  mark_untrusted_color(bgr, color.status(area), min_value, untrusted);
+  mark_missing_depth(depth_mm, missing);
   cv::bitwise_or(untrusted, missing, unknown);
-  return {color, depth, untrusted, missing, unknown};
+  return {area, bgr, depth_mm, untrusted, missing, unknown};
 }
 
 ResidueOutput::ResidueOutput(const Params& params)
     : dilation_px_(static_cast<int>(params.integer("dilation_px"))),
-      speckle_px_(static_cast<int>(params.integer("speckle_px"))) {}
+      speckle_px_(static_cast<int>(params.integer("speckle_px"))),
+      roi_(params.json("roi"), RegionOfInterest::Whole::kImage) {}
 
-void ResidueOutput::emit(Frame& frame, const cv::Mat& residue, const cv::Mat& not_residue,
-                         const cv::Mat& unknown, const cv::Mat& depth_mm) {
+cv::Rect ResidueOutput::area(cv::Size size) const {
+  const cv::Rect roi = roi_.on(size);
+  const cv::Rect grown(roi.x - kReachPx, roi.y - kReachPx, roi.width + 2 * kReachPx,
+                       roi.height + 2 * kReachPx);
+  return grown & cv::Rect({0, 0}, size);
+}
+
+void ResidueOutput::emit(Frame& frame, const cv::Rect& area, const cv::Mat& residue,
+                         const cv::Mat& not_residue, const cv::Mat& unknown,
+                         const cv::Mat& depth_mm) {
   const int rows = depth_mm.rows;
   const int cols = depth_mm.cols;
   thread_local BitMask residue_bits, unknown_bits;
@@ -123,16 +143,23 @@ void ResidueOutput::emit(Frame& frame, const cv::Mat& residue, const cv::Mat& no
       unknown_row[word] = marked_bits(unknown.ptr<std::uint8_t>(y) + x, count);
     }
   }
-  emit(frame, residue_bits, unknown_bits, depth_mm);
+  emit(frame, area, residue_bits, unknown_bits, depth_mm);
 }
 
-void ResidueOutput::emit(Frame& frame, BitMask& residue, const BitMask& unknown,
-                         const cv::Mat& depth_mm) {
+void ResidueOutput::emit(Frame& frame, const cv::Rect& area, BitMask& residue,
+                         const BitMask& unknown, const cv::Mat& depth_mm) {
+  const DepthImage& depth = frame.input<DepthImage>(kDepthInput);
   auto mask = masks_.acquire();
   auto soil = soil_depths_.acquire();
-  soil->rig = frame.input<DepthImage>(kDepthInput).rig;  // the soil's depth is the depth's
-  reuse_or_create(mask->values, depth_mm.rows, depth_mm.cols, CV_8UC1);
-  reuse_or_create(soil->mm, depth_mm.rows, depth_mm.cols, CV_32FC1);
+  soil->rig = depth.rig;  // the soil's depth is the depth's
+  reuse_or_create(mask->values, depth.mm.rows, depth.mm.cols, CV_8UC1);
+  reuse_or_create(soil->mm, depth.mm.rows, depth.mm.cols, CV_32FC1);
+  if (area.size() != depth.mm.size()) {
+    mask->values.setTo(ResidueMask::kUnknown);
+    soil->mm.setTo(std::numeric_limits<float>::quiet_NaN());
+  }
+  cv::Mat mask_area = mask->values(area);
+  cv::Mat soil_area = soil->mm(area);
 
   // An opening (erosion, then dilation by the same square) drops the specks; its
   // dilation and the edge dilation that follows add up to one square.
@@ -141,8 +168,8 @@ void ResidueOutput::emit(Frame& frame, BitMask& residue, const BitMask& unknown,
   residue.dilate(speckle_px_ + dilation_px_, morphology);
   for (int y = 0; y < depth_mm.rows; ++y) {
     kernels_.write_residue_row(unknown.row(y), residue.row(y), depth_mm.ptr<float>(y),
-                               depth_mm.cols, mask->values.ptr<std::uint8_t>(y),
-                               soil->mm.ptr<float>(y));
+                               depth_mm.cols, mask_area.ptr<std::uint8_t>(y),
+                               soil_area.ptr<float>(y));
   }
 
   frame.set_output(kMask, mask);

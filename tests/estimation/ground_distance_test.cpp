@@ -307,8 +307,11 @@ TEST(GroundDistance, RegionOutsideTheImageIsAnError) {
 
 TEST(GroundDistance, RegionParameterErrorsSayWhatIsExpected) {
   EXPECT_EQ(construction_error({{"roi", {1, 2, 3, 4}}}),
-            "parameter 'roi': expected null (the middle half of the image) or {\"x\", \"y\", "
+            "parameter 'roi': expected null, \"image\", \"middle_half\" or {\"x\", \"y\", "
             "\"width\", \"height\"} in pixels, got [1,2,3,4]");
+  EXPECT_EQ(construction_error({{"roi", "middle"}}),
+            "parameter 'roi': expected null, \"image\", \"middle_half\" or {\"x\", \"y\", "
+            "\"width\", \"height\"} in pixels, got \"middle\"");
   EXPECT_EQ(construction_error({{"roi", {{"x", 0}, {"y", 0}, {"width", 10}}}}),
             "parameter 'roi': missing field \"height\"");
   EXPECT_EQ(construction_error({{"roi", {{"x", 0}, {"y", 0}, {"w", 10}, {"height", 10}}}}),
