@@ -1,11 +1,9 @@
 #include "soil_region.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <sstream>
 
-#include "tilth/error.h"
 
 namespace tilth::estimation {
 namespace {

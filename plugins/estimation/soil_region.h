@@ -1,5 +1,5 @@
-// What the ground estimators share: the region of interest they read soil depths from,
-// when it shows too little soil to measure, how far a measurement can be trusted, and the
+// What the ground estimators share besides their region of interest (libs/roi): when it
+// shows too little soil to measure, how far a measurement can be trusted, and the
 // declarations of the parameters for these.
 #pragma once
 

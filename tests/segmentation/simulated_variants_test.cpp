@@ -175,8 +175,10 @@ TEST(SimulatedCaseC, AStageGivenARegionSegmentsItAsInTheWholeImage) {
   const json region = {{"x", roi.x}, {"y", roi.y}, {"width", roi.width}, {"height", roi.height}};
   const cv::Rect area(roi.x - 8, roi.y - 8, roi.width + 16, roi.height + 16);
   const std::vector<std::pair<const char*, StageDescriptor>> stages = {
-      {"color_threshold", describe_color_threshold()}, {"color_index", describe_color_index()},
-      {"lab_clusters", describe_lab_clusters()},       {"depth_aided", describe_depth_aided()},
+      {"color_threshold", describe_color_threshold()},
+      {"color_index", describe_color_index()},
+      {"lab_clusters", describe_lab_clusters()},
+      {"depth_aided", describe_depth_aided()},
       {"fusion", describe_fusion()}};
   for (const auto& [name, stage] : stages) {
     SCOPED_TRACE(name);
