@@ -138,8 +138,10 @@ class Run(unittest.TestCase):
         return tool
 
     def check_stopped_cleanly(self, tool):
+        """Every row written before the signal (the header and 100 rows at least: start()
+        waited for them) is there and whole; under load the stop may come before another."""
         self.assertEqual(tool.wait(), 0, tool.stderr())
-        self.assertGreater(whole_csv_rows(self, self.csv), 100)
+        self.assertGreaterEqual(whole_csv_rows(self, self.csv), 100)
         self.assertIn("stopping; frames in flight finish", tool.stderr())
 
     def test_sigterm_stops_cleanly(self):
