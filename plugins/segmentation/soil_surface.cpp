@@ -102,82 +102,131 @@ std::optional<Plane> ransac(const std::vector<Point>& points) {
   return best;
 }
 
+// A pixel may support the surface when it is a candidate and has a (median) depth.
+bool supports(float depth, std::uint8_t missing, std::uint8_t candidate) {
+  return candidate != 0 && missing == 0 && depth > 0;
+}
+
 // The RANSAC plane through the depths of every kSampleStepPx-th supported pixel, unless
 // too few are supported.
-std::optional<Plane> farthest_plane(const cv::Mat& depth, const cv::Mat& support) {
+std::optional<Plane> farthest_plane(const cv::Mat& depth, const cv::Mat& missing,
+                                    const cv::Mat& candidates) {
   thread_local std::vector<Point> points;
   points.clear();
   for (int row = kSampleStepPx / 2; row < depth.rows; row += kSampleStepPx) {
     const auto* d = depth.ptr<float>(row);
-    const auto* soil = support.ptr<std::uint8_t>(row);
+    const auto* none = missing.ptr<std::uint8_t>(row);
+    const auto* candidate = candidates.ptr<std::uint8_t>(row);
     for (int col = kSampleStepPx / 2; col < depth.cols; col += kSampleStepPx) {
-      if (soil[col] != 0) points.push_back({double(col), double(row), d[col]});
+      if (supports(d[col], none[col], candidate[col]))
+        points.push_back({double(col), double(row), d[col]});
     }
   }
   return points.size() < kMinPoints ? std::nullopt : ransac(points);
 }
 
-// The envelope on the half-resolution grid: a morphological closing of the depth of the
-// pixels that may be soil (the farthest depth within the window, then the nearest of
-// those). Residue narrower than the window is gone from it; ground that slopes, curves
-// gently or steps over more than a window is kept as it is. NaN where no pixel within the
-// window may be soil.
-void envelope(const cv::Mat& depth, const cv::Mat& support, double window_px, cv::Mat& surface) {
-  constexpr float kNoSurface = std::numeric_limits<float>::max();
-  thread_local cv::Mat farthest, none;
-  farthest.create(depth.size(), CV_32FC1);
-  farthest.setTo(0);
-  depth.copyTo(farthest, support);
-  const int side = 2 * static_cast<int>(std::lround(window_px / 4)) + 1;  // odd, half scale
-  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, {side, side});
-  cv::dilate(farthest, surface, window);
-  cv::compare(surface, 0, none, cv::CMP_LE);
-  surface.setTo(kNoSurface, none);
-  cv::erode(surface, surface, window);
-  cv::compare(surface, kNoSurface, none, cv::CMP_EQ);
-  surface.setTo(std::numeric_limits<float>::quiet_NaN(), none);
+// The depth of every second pixel of every second row, and 0 where it may not support
+// the surface.
+void half_support(const cv::Mat& depth, const cv::Mat& missing, const cv::Mat& candidates,
+                  cv::Mat& supported) {
+  supported.create((depth.rows + 1) / 2, (depth.cols + 1) / 2, CV_32FC1);
+  for (int row = 0; row < supported.rows; ++row) {
+    const auto* d = depth.ptr<float>(2 * row);
+    const auto* none = missing.ptr<std::uint8_t>(2 * row);
+    const auto* candidate = candidates.ptr<std::uint8_t>(2 * row);
+    auto* out = supported.ptr<float>(row);
+    for (int col = 0; col < supported.cols; ++col) {
+      const int at = 2 * col;
+      out[col] = supports(d[at], none[at], candidate[at]) ? d[at] : 0.0f;
+    }
+  }
 }
 
-// The local surface, on every second pixel of every second row (it varies over several
-// pixels, and this is a quarter of the work), starting from the plane. Each pass: the
-// soil is what lies no higher than height_mm above the current surface; the new surface
-// is the Gaussian-weighted mean of its depths, or stays where there is too little soil
-// nearby (under a hundredth of the kernel's weight).
-void follow_relief(const std::optional<Plane>& plane, double envelope_px, const cv::Mat& depth,
-                   const cv::Mat& support, double height_mm, double surface_px, cv::Mat& surface) {
-  thread_local cv::Mat depth_half, support_half, surface_half, height, soil, weight, weighted;
-  cv::resize(depth, depth_half, {}, 0.5, 0.5, cv::INTER_NEAREST);
-  cv::resize(support, support_half, {}, 0.5, 0.5, cv::INTER_NEAREST);
-  if (plane) {
-    surface_half.create(depth_half.size(), CV_32FC1);
-    for (int row = 0; row < surface_half.rows; ++row) {
-      auto* s = surface_half.ptr<float>(row);
-      for (int col = 0; col < surface_half.cols; ++col) {
-        s[col] = static_cast<float>(plane->at(2 * col, 2 * row));
-      }
-    }
-  } else {
-    envelope(depth_half, support_half, envelope_px, surface_half);
+// The envelope of the supported depths (0: none): a morphological closing (the farthest
+// depth within the window, then the nearest of those). Residue narrower than the window
+// is gone from it; ground that slopes, curves gently or steps over more than a window is
+// kept as it is. NaN where no pixel within the window may be soil.
+void envelope(const cv::Mat& supported, int side, cv::Mat& surface) {
+  constexpr float kNoSurface = std::numeric_limits<float>::max();
+  thread_local cv::Mat farthest;
+  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, {side, side});
+  cv::dilate(supported, farthest, window);
+  for (int row = 0; row < farthest.rows; ++row) {
+    auto* f = farthest.ptr<float>(row);
+    for (int col = 0; col < farthest.cols; ++col) f[col] = f[col] > 0 ? f[col] : kNoSurface;
   }
-  const double sigma = surface_px / 2;
-  for (int pass = 0; surface_px > 0 && pass < kLocalPasses; ++pass) {
-    cv::subtract(surface_half, depth_half, height);
-    cv::compare(height, height_mm, soil, cv::CMP_LT);
-    cv::bitwise_and(soil, support_half, soil);
-    soil.convertTo(weight, CV_32F, 1.0 / 255);
-    cv::multiply(depth_half, weight, weighted);
-    cv::GaussianBlur(weighted, weighted, {0, 0}, sigma);
-    cv::GaussianBlur(weight, weight, {0, 0}, sigma);
-    for (int row = 0; row < surface_half.rows; ++row) {
-      auto* s = surface_half.ptr<float>(row);
-      const auto* sum = weighted.ptr<float>(row);
-      const auto* w = weight.ptr<float>(row);
-      for (int col = 0; col < surface_half.cols; ++col) {
-        if (w[col] > 0.01f) s[col] = sum[col] / w[col];
-      }
+  cv::erode(farthest, surface, window);
+  for (int row = 0; row < surface.rows; ++row) {
+    auto* s = surface.ptr<float>(row);
+    for (int col = 0; col < surface.cols; ++col) {
+      if (s[col] == kNoSurface) s[col] = std::numeric_limits<float>::quiet_NaN();
     }
   }
-  cv::resize(surface_half, surface, depth.size(), 0, 0, cv::INTER_LINEAR);
+}
+
+// Follows the relief from a start (a plane or the envelope) on the half-resolution grid
+// (the surface varies over several pixels, and this is a quarter of the work). Each pass:
+// the soil is what is supported and lies no higher than height_mm above the current
+// surface; the new surface is the Gaussian-weighted mean of its depths, or stays where
+// there is too little soil nearby (under a hundredth of the kernel's weight).
+void follow_relief(const cv::Mat& supported, double height_mm, double surface_px,
+                   cv::Mat& surface) {
+  thread_local cv::Mat soil;  // (depth, 1) of each soil pixel, (0, 0) elsewhere
+  soil.create(supported.size(), CV_32FC2);
+  const float below = static_cast<float>(height_mm);
+  for (int pass = 0; pass < kLocalPasses; ++pass) {
+    for (int row = 0; row < supported.rows; ++row) {
+      const auto* d = supported.ptr<float>(row);
+      const auto* s = surface.ptr<float>(row);
+      auto* out = soil.ptr<float>(row);
+      for (int col = 0; col < supported.cols; ++col) {
+        const float is_soil = d[col] > 0 && s[col] - d[col] < below ? 1.0f : 0.0f;  // NaN: 0
+        out[2 * col] = is_soil * d[col];
+        out[2 * col + 1] = is_soil;
+      }
+    }
+    cv::GaussianBlur(soil, soil, {0, 0}, surface_px / 2);
+    for (int row = 0; row < surface.rows; ++row) {
+      auto* s = surface.ptr<float>(row);
+      const auto* mean = soil.ptr<float>(row);
+      for (int col = 0; col < surface.cols; ++col) {
+        const float weight = mean[2 * col + 1];
+        s[col] = weight > 0.01f ? mean[2 * col] / weight : s[col];
+      }
+    }
+  }
+}
+
+// Each pixel's height above the half-resolution surface, upsampled bilinearly (pixel
+// centres aligned, edges clamped); NaN where the pixel has no depth.
+void heights_above(const cv::Mat& half, const cv::Mat& depth, const cv::Mat& missing,
+                   cv::Mat& height) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  thread_local std::vector<float> blended, surface;  // one row: half, padded; full
+  blended.resize(static_cast<std::size_t>(half.cols) + 2);
+  surface.resize(static_cast<std::size_t>(2 * half.cols));
+  height.create(depth.size(), CV_32FC1);
+  for (int row = 0; row < depth.rows; ++row) {
+    const int other = std::clamp(row % 2 == 0 ? row / 2 - 1 : row / 2 + 1, 0, half.rows - 1);
+    const auto* near_line = half.ptr<float>(row / 2);
+    const auto* other_line = half.ptr<float>(other);
+    float* const line = blended.data() + 1;
+    for (int col = 0; col < half.cols; ++col) {
+      line[col] = 0.75f * near_line[col] + 0.25f * other_line[col];
+    }
+    line[-1] = line[0];
+    line[half.cols] = line[half.cols - 1];
+    for (int col = 0; col < half.cols; ++col) {
+      surface[2 * col] = 0.75f * line[col] + 0.25f * line[col - 1];
+      surface[2 * col + 1] = 0.75f * line[col] + 0.25f * line[col + 1];
+    }
+    const auto* d = depth.ptr<float>(row);
+    const auto* none = missing.ptr<std::uint8_t>(row);
+    auto* out = height.ptr<float>(row);
+    for (int col = 0; col < depth.cols; ++col) {
+      out[col] = none[col] == 0 && d[col] > 0 ? surface[col] - d[col] : kNaN;
+    }
+  }
 }
 
 }  // namespace
@@ -187,38 +236,38 @@ SoilSurface::SoilSurface(double height_mm, double surface_px, double envelope_px
 
 void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
                           const cv::Mat& candidates, cv::Mat& height_mm) const {
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  thread_local cv::Mat depth, no_depth, support, surface;
+  thread_local cv::Mat zeroed, depth, supported, surface;
   // A 3x3 median: a third of the ToF noise, and single dropouts (0 here) do not count;
   // where most neighbours have none, neither has the pixel.
-  depth_mm.copyTo(depth);
-  depth.setTo(0, missing);
-  cv::medianBlur(depth, depth, 3);
-  cv::compare(depth, 0, no_depth, cv::CMP_LE);
-  cv::bitwise_or(no_depth, missing, no_depth);
-  cv::bitwise_and(candidates, ~no_depth, support);
+  zeroed.create(depth_mm.size(), CV_32FC1);
+  for (int row = 0; row < depth_mm.rows; ++row) {
+    const auto* in = depth_mm.ptr<float>(row);
+    const auto* none = missing.ptr<std::uint8_t>(row);
+    auto* out = zeroed.ptr<float>(row);
+    for (int col = 0; col < depth_mm.cols; ++col) out[col] = none[col] != 0 ? 0.0f : in[col];
+  }
+  cv::medianBlur(zeroed, depth, 3);
+  half_support(depth, missing, candidates, supported);
 
   if (envelope_px_ > 0) {
-    follow_relief(std::nullopt, envelope_px_, depth, support, height_mm_, surface_px_, surface);
+    envelope(supported, 2 * static_cast<int>(std::lround(envelope_px_ / 4)) + 1, surface);
   } else {
-    const std::optional<Plane> plane = farthest_plane(depth, support);
-    height_mm.create(depth_mm.size(), CV_32FC1);
+    const std::optional<Plane> plane = farthest_plane(depth, missing, candidates);
     if (!plane) {
-      height_mm.setTo(kNaN);
+      height_mm.create(depth_mm.size(), CV_32FC1);
+      height_mm.setTo(std::numeric_limits<float>::quiet_NaN());
       return;
     }
-    if (surface_px_ <= 0) {
-      surface.create(depth.size(), CV_32FC1);
-      for (int row = 0; row < depth.rows; ++row) {
-        auto* s = surface.ptr<float>(row);
-        for (int col = 0; col < depth.cols; ++col) s[col] = static_cast<float>(plane->at(col, row));
+    surface.create(supported.size(), CV_32FC1);
+    for (int row = 0; row < surface.rows; ++row) {
+      auto* s = surface.ptr<float>(row);
+      for (int col = 0; col < surface.cols; ++col) {
+        s[col] = static_cast<float>(plane->at(2 * col + 0.5, 2 * row + 0.5));
       }
-    } else {
-      follow_relief(plane, 0.0, depth, support, height_mm_, surface_px_, surface);
     }
   }
-  cv::subtract(surface, depth, height_mm);
-  height_mm.setTo(kNaN, no_depth);
+  if (surface_px_ > 0) follow_relief(supported, height_mm_, surface_px_, surface);
+  heights_above(surface, depth, missing, height_mm);
 }
 
 ParamSpec height_mm_param() {
