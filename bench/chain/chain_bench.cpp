@@ -11,7 +11,6 @@
 #include <array>
 #include <atomic>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <new>
 #include <sstream>
@@ -23,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "framework/graph_loader.h"
 #include "framework/stage_registry.h"
 #include "tilth/calibration.h"
 #include "tilth/messages/color_image.h"
@@ -89,17 +89,20 @@ StageInstance make(const std::string& type, nlohmann::json params = nlohmann::js
   return registry().create(type, StageContext{type, Params(params), Logger(type), {}});
 }
 
-// The node `name` of the chain file, its parameters completed as `make` does.
+// The node `name` of the chain file as the graph loader reads it (variables substituted),
+// its parameters completed as `make` does.
 StageInstance chain_node(const std::string& name) {
-  static const nlohmann::json nodes = [] {
+  static const GraphSpec chain = [] {
     const char* const chosen = std::getenv("TILTH_CHAIN_GRAPH");
-    const std::string path = chosen ? chosen : TILTH_SOURCE_DIR "/graphs/measurement-chain.json";
-    std::ifstream file(path);
-    if (!file) throw std::runtime_error("cannot read the chain file " + path);
-    return nlohmann::json::parse(file, nullptr, true, /*ignore_comments=*/true).at("nodes");
+    return load_graph(chosen ? chosen : TILTH_SOURCE_DIR "/graphs/measurement-chain.json");
   }();
-  const nlohmann::json& node = nodes.at(name);
-  return make(node.at("type"), node.value("params", nlohmann::json::object()));
+  for (const NodeSpec& node : chain.nodes) {
+    if (node.name != name) continue;
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& [key, param] : node.params) params[key] = param.value;
+    return make(node.type, params);
+  }
+  throw std::runtime_error("the chain file has no node '" + name + "'");
 }
 
 // One frame pair (raw ToF, colour) of the simulator's case_c in `color_format`, rendered

@@ -81,6 +81,13 @@ cv::Rect RegionOfInterest::on(cv::Size image) const {
   return region;
 }
 
+cv::Rect RegionOfInterest::around(cv::Size image, int margin_px) const {
+  const cv::Rect region = on(image);
+  const cv::Rect grown(region.x - margin_px, region.y - margin_px, region.width + 2 * margin_px,
+                       region.height + 2 * margin_px);
+  return grown & cv::Rect({0, 0}, image);
+}
+
 bool RegionOfInterest::clipped_on(cv::Size image) const { return on(image) != unclipped_on(image); }
 
 std::string RegionOfInterest::clipping_note(cv::Size image) const {

@@ -11,7 +11,10 @@
 //
 // Invariant: a pixel gets a colour only when its status is kValid; every other pixel is
 // black and says why: kNoDepth (NaN depth), kOutsideColor (behind the colour camera or
-// outside its image), kOccluded (the colour camera sees a nearer point there).
+// outside its image), kOccluded (the colour camera sees a nearer point there),
+// kNotRegistered (its row is outside the region of interest and the 8 px around it that
+// the segmentation reads). The z-buffer always holds every depth pixel, so occlusion
+// inside the region is the same as in a whole image.
 //
 // Occlusion is a z-buffer over the colour image, in cells just large enough that a
 // surface seen by both cameras leaves none empty (OcclusionCells): a first pass keeps the
@@ -33,6 +36,7 @@
 
 #include "color_sampler.h"
 #include "depth_to_color.h"
+#include "roi/region_of_interest.h"
 #include "row_kernels.h"
 #include "tilth/error.h"
 #include "tilth/frame_calibration.h"
@@ -167,12 +171,18 @@ Visibility visibility(const Scratch& scratch, const OcclusionCells& cells, float
           RegisteredColor::kOccluded};
 }
 
+// Rows [first, last) of the depth grid are registered.
+struct Rows {
+  int first;
+  int last;
+};
+
 void register_nearest(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                      const NearestPixels& pixels, float occlusion_tolerance_mm, Scratch& scratch,
-                      RegisteredColor& out) {
+                      const NearestPixels& pixels, float occlusion_tolerance_mm, Rows rows,
+                      Scratch& scratch, RegisteredColor& out) {
   fill_z_buffer(map, cells, depth, pixels.addressing, false, scratch);
   const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
-  for (int v = 0; v < map.depth_height(); ++v) {
+  for (int v = rows.first; v < rows.last; ++v) {
     const LocatedRow row = scratch.locate_second(map, cells, depth, v, pixels.addressing);
     map.kernels().resolve(seen, pixels.word, map.depth_width(), depth.ptr<float>(v), row.depth_mm,
                           row.cell, row.key, out.status.ptr<std::uint8_t>(v),
@@ -206,15 +216,15 @@ Bgr bilinear_sample(const Sampler& sampler, float u, float v, int width, int hei
 
 template <class Sampler>
 void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                       const Sampler& sampler, const float occlusion_tolerance_mm, Scratch& scratch,
-                       RegisteredColor& out) {
+                       const Sampler& sampler, const float occlusion_tolerance_mm, Rows rows,
+                       Scratch& scratch, RegisteredColor& out) {
   const Sampler colors = sampler;  // a local: see LocatedRow
   fill_z_buffer(map, cells, depth, colors.addressing(), true, scratch);
   const float* const nearest_mm = scratch.nearest_mm.data();
   const int outside = cells.grid().outside;
   const int color_width = map.color_width();
   const int color_height = map.color_height();
-  for (int v = 0; v < map.depth_height(); ++v) {
+  for (int v = rows.first; v < rows.last; ++v) {
     const LocatedRow row = scratch.locate_second(map, cells, depth, v, colors.addressing());
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
@@ -254,7 +264,8 @@ class ProjectiveRegistration final : public Transform {
                      }),
         occlusion_tolerance_mm_(
             static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
-        bilinear_(context.params.string("interpolation") == "bilinear") {}
+        bilinear_(context.params.string("interpolation") == "bilinear"),
+        roi_(context.params.json("roi"), RegionOfInterest::Whole::kImage) {}
 
   void process(Frame& frame) override {
     const DepthImage& depth = frame.input<DepthImage>(0);
@@ -267,12 +278,15 @@ class ProjectiveRegistration final : public Transform {
     auto out = outputs_.acquire();
     reuse_or_create(out->bgr, map.depth_height(), map.depth_width(), CV_8UC3);
     reuse_or_create(out->status, map.depth_height(), map.depth_width(), CV_8UC1);
+    const cv::Rect region = roi_.around(depth.mm.size(), RegionOfInterest::kMarginPx);
+    const Rows rows{region.y, region.y + region.height};
+    mark_not_registered(rows, *out);
     const auto scratch = scratch_.acquire();
     if (bilinear_) {
-      register_bilinear(geometry, depth.mm, color, *scratch, *out);
+      register_bilinear(geometry, depth.mm, color, rows, *scratch, *out);
     } else {
       register_nearest(map, geometry.cells, depth.mm, nearest_pixels(color.pixels, color.format),
-                       occlusion_tolerance_mm_, *scratch, *out);
+                       occlusion_tolerance_mm_, rows, *scratch, *out);
     }
     frame.set_output(0, std::move(out));
   }
@@ -281,10 +295,10 @@ class ProjectiveRegistration final : public Transform {
   // Bilinear sampling blends demosaiced pixels. OpenCV names a mosaic by its second
   // row's second and third pixels, one pixel off the usual naming by the top-left tile.
   void register_bilinear(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color,
-                         Scratch& scratch, RegisteredColor& out) const {
+                         Rows rows, Scratch& scratch, RegisteredColor& out) const {
     const auto run = [&](const auto& sampler) {
       registration::register_bilinear(geometry.map, geometry.cells, depth, sampler,
-                                      occlusion_tolerance_mm_, scratch, out);
+                                      occlusion_tolerance_mm_, rows, scratch, out);
     };
     const auto demosaiced = [&](int opencv_code) {
       cv::cvtColor(color.pixels, scratch.demosaiced, opencv_code);
@@ -305,6 +319,16 @@ class ProjectiveRegistration final : public Transform {
         return run(demosaiced(cv::COLOR_BayerGB2BGR));
       case PixelFormat::kBayerGbrg8:
         return run(demosaiced(cv::COLOR_BayerGR2BGR));
+    }
+  }
+
+  // The rows outside `rows`; the images are continuous (reuse_or_create).
+  static void mark_not_registered(Rows rows, RegisteredColor& out) {
+    for (const auto [first, last] : {Rows{0, rows.first}, Rows{rows.last, out.status.rows}}) {
+      const auto count = static_cast<std::size_t>(last - first);
+      if (count == 0) continue;
+      std::memset(out.status.ptr(first), RegisteredColor::kNotRegistered, count * out.status.step);
+      std::memset(out.bgr.ptr(first), 0, count * out.bgr.step);
     }
   }
 
@@ -334,6 +358,7 @@ class ProjectiveRegistration final : public Transform {
   FrameCalibration<Geometry> calibration_;
   const float occlusion_tolerance_mm_;
   const bool bilinear_;
+  const RegionOfInterest roi_;
   MessagePool<RegisteredColor> outputs_;
   MessagePool<Scratch> scratch_;  // one per frame in flight
 };
@@ -361,6 +386,7 @@ StageDescriptor describe_projective() {
       ParamSpec::choice("interpolation", {"nearest", "bilinear"}, "nearest")
           .describe("colour sampling: nearest keeps measured colours (of a Bayer mosaic: the "
                     "2x2 quad nearest the point), bilinear blends four demosaiced pixels"),
+      roi_param(RegionOfInterest::Whole::kImage),
       ParamSpec::choice("instruction_set", row_kernel_levels(), "auto")
           .describe("the vector loops' instruction set: auto = the widest this CPU runs; "
                     "others for comparison"),

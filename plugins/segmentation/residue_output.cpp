@@ -12,11 +12,6 @@
 namespace tilth::segmentation {
 namespace {
 
-// The farthest the outputs' last steps reach from a pixel: colour smoothing
-// (smoothing_px <= 3) or speckle removal and dilation (speckle_px + dilation_px), rounded
-// up to whole 8-pixel steps.
-constexpr int kReachPx = 8;
-
 std::string size_text(const cv::Mat& image) {
   return std::to_string(image.cols) + "x" + std::to_string(image.rows);
 }
@@ -118,10 +113,7 @@ ResidueOutput::ResidueOutput(const Params& params)
       roi_(params.json("roi"), RegionOfInterest::Whole::kImage) {}
 
 cv::Rect ResidueOutput::area(cv::Size size) const {
-  const cv::Rect roi = roi_.on(size);
-  const cv::Rect grown(roi.x - kReachPx, roi.y - kReachPx, roi.width + 2 * kReachPx,
-                       roi.height + 2 * kReachPx);
-  return grown & cv::Rect({0, 0}, size);
+  return roi_.around(size, RegionOfInterest::kMarginPx);
 }
 
 void ResidueOutput::emit(Frame& frame, const cv::Rect& area, const cv::Mat& residue,

@@ -73,7 +73,7 @@ class UsageTest(unittest.TestCase):
                     "--variant", "b:segment.dilation_px=-1", "--out", self.out)
         self.assert_refused(result,
                             "command line:--variant a:segment.dilaton_px=3: unknown parameter "
-                            "'dilaton_px' of segmentation.color_threshold; did you mean "
+                            "'dilaton_px' of segmentation.fusion; did you mean "
                             "'dilation_px'?",
                             "command line:--variant b:segment.dilation_px=-1: parameter "
                             "'dilation_px': expected an integer")

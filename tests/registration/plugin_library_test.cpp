@@ -25,7 +25,8 @@ TEST(RegistrationPlugin, TheLibraryProvidesTheProjectiveStage) {
                              Params(nlohmann::json{{"calibration", calibration},
                                                    {"occlusion_tolerance_mm", 10.0},
                                                    {"interpolation", "nearest"},
-                                                   {"instruction_set", "auto"}}),
+                                                   {"instruction_set", "auto"},
+                                                   {"roi", nullptr}}),
                              Logger("registration"),
                              {}};
   StageInstance instance = registry.create("registration.projective", context);

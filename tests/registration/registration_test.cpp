@@ -26,6 +26,7 @@
 #include "depth_to_color.h"
 #include "projective.h"
 #include "reference_geometry.h"
+#include "roi/region_of_interest.h"
 #include "row_kernels.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
@@ -83,12 +84,14 @@ json rotation(double x_deg, double y_deg, double z_deg) {
 std::unique_ptr<Transform> make_registration(const fs::path& calibration,
                                              const std::string& interpolation = "nearest",
                                              double occlusion_tolerance_mm = 10.0,
-                                             const std::string& instruction_set = "auto") {
+                                             const std::string& instruction_set = "auto",
+                                             const json& roi = nullptr) {
   const StageContext context{"registration",
                              Params(json{{"calibration", calibration.string()},
                                          {"occlusion_tolerance_mm", occlusion_tolerance_mm},
                                          {"interpolation", interpolation},
-                                         {"instruction_set", instruction_set}}),
+                                         {"instruction_set", instruction_set},
+                                         {"roi", roi}}),
                              Logger("registration"),
                              {}};
   std::unique_ptr<Stage> stage = describe_projective().create(context);
@@ -415,13 +418,12 @@ struct BoxOcclusion {
   int coloured_flagged = 0;
 };
 
-// A plane at 518 mm and a 150 mm tall box on it, 120 x 120 mm around the ToF's axis,
-// registered with the rig in `document`. Wherever the colour camera's centre (-R^T T)
+// A plane at 518 mm and a 150 mm tall box on it, 120 x 120 mm around the ToF's axis, as
+// the ToF of `rig` sees it; `hidden_mm`: how far behind the first surface the colour
+// camera meets on its way to each point. Wherever the colour camera's centre (-R^T T)
 // lies to the side, it cannot see a strip of plane the ToF sees just beyond the box's
 // far edge.
-BoxOcclusion occlusion_by_a_box(const json& document) {
-  const CalibrationFile file(document);
-  const ref::Rig rig = ref::rig_from(document);
+cv::Mat box_on_a_plane(const ref::Rig& rig, cv::Mat& hidden_mm) {
   const auto rays = depth_rays(rig);
   const Real plane = 518 + rig.z_offset;
   const ref::Vec3 box_low{-60, -60, plane - 150};
@@ -430,8 +432,7 @@ BoxOcclusion occlusion_by_a_box(const json& document) {
   const ref::Vec3 colour_centre = ref::color_centre(rig);
 
   cv::Mat depth(rig.depth.height, rig.depth.width, CV_32FC1);
-  // How far behind the first surface the colour camera meets on its way to the point.
-  cv::Mat hidden_mm(depth.size(), CV_32FC1);
+  hidden_mm.create(depth.size(), CV_32FC1);
   for (int v = 0; v < depth.rows; ++v) {
     for (int u = 0; u < depth.cols; ++u) {
       const ref::Vec3 ray = rays[static_cast<std::size_t>(v * depth.cols + u)];
@@ -444,6 +445,14 @@ BoxOcclusion occlusion_by_a_box(const json& document) {
       hidden_mm.at<float>(v, u) = static_cast<float>(std::max(behind, Real{0}));
     }
   }
+  return depth;
+}
+
+// The box on the plane registered with the rig in `document`.
+BoxOcclusion occlusion_by_a_box(const json& document) {
+  const CalibrationFile file(document);
+  cv::Mat hidden_mm;
+  const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);
   const auto out = register_color(*make_registration(file.path()), depth, coordinate_image());
 
   // Clearly occluded: hidden by more than the tolerance (10 mm) + 15 mm, as are all
@@ -521,6 +530,42 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheIma
   json document = paper_rig();
   document["depth_to_color"]["T_mm"] = {60.0, 0.0, 150.0};
   expect_occlusion_found(occlusion_by_a_box(document), 500);
+}
+
+TEST(ProjectiveRegistration, ARegionIsRegisteredAsInTheWholeImage) {
+  // The rotated diagonal rig: the box hides plane in rows other than its own, so a band
+  // that holds hidden plane but not all of the box needs the z-buffer of every row.
+  json document = paper_rig();
+  document["depth_to_color"]["R"] = rotation(3, -4, 2);
+  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  const CalibrationFile file(document);
+  cv::Mat hidden_mm;
+  const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);
+  const auto whole = register_color(*make_registration(file.path()), depth, coordinate_image());
+
+  int occluded_in_bands = 0;
+  for (const int y : {0, 100, 160, 220, 280, 340, 440}) {
+    const json roi = {{"x", 200}, {"y", y}, {"width", 240}, {"height", 40}};
+    const auto part = register_color(*make_registration(file.path(), "nearest", 10.0, "auto", roi),
+                                     depth, coordinate_image());
+    // Rows y - 8 .. y + 48 (kMarginPx around the region), clipped to the image.
+    const cv::Range band(std::max(y - RegionOfInterest::kMarginPx, 0),
+                         std::min(y + 40 + RegionOfInterest::kMarginPx, depth.rows));
+    for (int v = 0; v < depth.rows; ++v) {
+      const bool inside = v >= band.start && v < band.end;
+      const cv::Mat status = part->status.row(v);
+      if (inside) {
+        EXPECT_EQ(cv::countNonZero(status != whole->status.row(v)), 0) << "row " << v;
+        EXPECT_EQ(cv::norm(part->bgr.row(v), whole->bgr.row(v), cv::NORM_INF), 0) << "row " << v;
+      } else {
+        EXPECT_EQ(cv::countNonZero(status != RegisteredColor::kNotRegistered), 0) << "row " << v;
+        EXPECT_EQ(cv::countNonZero(part->bgr.row(v).reshape(1)), 0) << "row " << v;
+      }
+    }
+    occluded_in_bands +=
+        cv::countNonZero(part->status.rowRange(band) == RegisteredColor::kOccluded);
+  }
+  EXPECT_GT(occluded_in_bands, 500);  // the bands hold the case
 }
 
 // The 2x2 tile of each mosaic, row by row.

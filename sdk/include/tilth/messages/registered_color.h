@@ -15,9 +15,10 @@ struct RegisteredColor : MessageOf<RegisteredColor> {
 
   enum Status : std::uint8_t {
     kValid = 0,
-    kNoDepth = 1,       // the depth pixel has no measurement
-    kOutsideColor = 2,  // it projects outside the colour image
-    kOccluded = 3,      // the colour camera sees something nearer along that ray
+    kNoDepth = 1,        // the depth pixel has no measurement
+    kOutsideColor = 2,   // it projects outside the colour image
+    kOccluded = 3,       // the colour camera sees something nearer along that ray
+    kNotRegistered = 4,  // outside the rows registered (the stage's region of interest)
   };
 
   cv::Mat bgr;     // CV_8UC3, depth grid size; black where status != kValid
