@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The scenario matrix behind docs/accuracy-field.md: every chain variant over every simulated
+"""The scenario matrix behind docs/accuracy.md: every chain variant over every simulated
 scenario (a scene preset seen by a rig, with a colour format), with ground truth.
 
 Each scenario is simulated (`tilth simulate`) into an image-folder recording; `tilth ab`
@@ -10,11 +10,12 @@ at least 5 % of the image is visible soil) and the false-valid ones (valid altho
 1 % is). On moving ground the frames in which a soil step passes the tool point are left
 out of the error (the truth itself jumps there) and counted apart.
 
-    python3 tools/accuracy.py > docs/accuracy-field.md      # the whole matrix
+    python3 tools/accuracy.py > docs/accuracy.md            # the whole matrix
     python3 tools/accuracy.py --small --check field         # what CI runs (tests/CMakeLists.txt)
 
---check VARIANT exits 1 unless that variant meets the bounds of docs/accuracy-field.md on every
-scenario. TILTH=path/to/tilth uses another build.
+--check VARIANT exits 1 unless that variant meets the bounds of docs/accuracy.md on every
+scenario. TILTH=path/to/tilth uses another build. --recordings DIR keeps the simulated
+recordings there and reuses them on the next run (to compare variants without rendering again).
 """
 import argparse
 import csv
@@ -56,7 +57,8 @@ class Scenario:
         self.rig = rig
         self.color_format = color_format
         self.frames = frames
-        self.name = preset if rig == "paper" else "%s@%s_rig" % (preset, rig)
+        # as tilth ab names the recording of its folder
+        self.name = preset if rig == "paper" else "%s_%s_rig" % (preset, rig)
 
     def simulate(self, tilth, folder, frames):
         command = [tilth, "simulate", folder, "--preset", self.preset,
@@ -134,9 +136,10 @@ def run_matrix(args, work):
     listed = scenarios(args.small, args.frames)
     folders = []
     for scenario in listed:
-        folder = os.path.join(work, scenario.name)
-        print("accuracy.py: simulating %s" % scenario.name, file=sys.stderr)
-        scenario.simulate(args.tilth, folder, args.frames)
+        folder = os.path.join(args.recordings or work, scenario.name)
+        if not os.path.isdir(folder):
+            print("accuracy.py: simulating %s" % scenario.name, file=sys.stderr)
+            scenario.simulate(args.tilth, folder, args.frames)
         folders.append(folder)
     report = os.path.join(work, "ab")
     subprocess.run([args.tilth, "ab", *folders, "--variants", args.variants, "--out", report,
@@ -155,7 +158,7 @@ def print_report(args, listed, variants, cells):
     print("# Accuracy on simulated field scenarios\n")
     options = (" --small" if args.small else "") + (
         " --frames %d" % args.frames if args.frames != (3 if args.small else 8) else "")
-    print("Produced by `python3 tools/accuracy.py%s > docs/accuracy-field.md` (after building):"
+    print("Produced by `python3 tools/accuracy.py%s > docs/accuracy.md` (after building):"
           % options)
     print("each scenario is a scene preset of docs/simulator.md, seen by a rig (`calib/`) with")
     print("a colour format, simulated (seed 1) into an image-folder recording; `tilth ab` runs")
@@ -211,6 +214,8 @@ def main():
     parser.add_argument("--check", metavar="VARIANT",
                         help="exit 1 unless VARIANT meets the bounds on every scenario")
     parser.add_argument("--variants", default=VARIANTS)
+    parser.add_argument("--recordings", metavar="DIR",
+                        help="keep the simulated recordings here, and reuse those already here")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--tilth", default=os.environ.get(
         "TILTH", os.path.join(SOURCE, "build", "bin", "tilth")))

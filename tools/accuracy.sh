@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Reproduces docs/accuracy.md: simulates the paper's static cases A-E (and the hard
+# Reproduces docs/accuracy-paper-cases.md: simulates the paper's static cases A-E (and the hard
 # cases) into image-folder recordings, runs graphs/paper.json on each, and tabulates
 # the distance error against ground truth like the paper's Table 2.
-# usage: bash tools/accuracy.sh [FRAMES_PER_CASE [REPORT OPTIONS]] > docs/accuracy.md
+# usage: bash tools/accuracy.sh [FRAMES_PER_CASE [REPORT OPTIONS]] > docs/accuracy-paper-cases.md
 #   (after building; TILTH=path/to/tilth to use another build, COLOR_FORMAT=bayer_rggb8
 #   to have the colour camera deliver a Bayer mosaic instead of bgr8)
 set -euo pipefail

@@ -31,13 +31,13 @@ def main():
     args = parser.parse_args()
     problems = []
 
-    print("# Accuracy on simulated recordings\n")
-    print("Produced by `bash tools/accuracy.sh %d > docs/accuracy.md`: each case is simulated"
+    print("# Accuracy on the paper's cases\n")
+    print("Produced by `bash tools/accuracy.sh %d > docs/accuracy-paper-cases.md`: each case"
           % args.frames)
-    print("(`graphs/simulate.json`, %d frames, seed 1) into an image-folder recording and"
+    print("is simulated (`graphs/simulate.json`, %d frames, seed 1) into an image-folder"
           % args.frames)
-    print("measured by `graphs/paper.json` (projection, registration, colour-threshold")
-    print("segmentation, median estimator). Errors are detected minus actual distance.\n")
+    print("recording and measured by `graphs/paper.json` (the measurement chain,")
+    print("`graphs/measurement-chain.json`). Errors are detected minus actual distance.\n")
     print("| case | frames | valid | detected (mm) | actual (mm) | error (mm) | std (mm) "
           "| max abs (mm) | 95% CI of error (mm) |")
     print("|---|---|---|---|---|---|---|---|---|")

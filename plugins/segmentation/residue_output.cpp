@@ -145,6 +145,7 @@ void ResidueOutput::emit(Frame& frame, const cv::Rect& area, BitMask& residue,
   auto soil = soil_depths_.acquire();
   soil->rig = depth.rig;  // the soil's depth is the depth's
   reuse_or_create(mask->values, depth.mm.rows, depth.mm.cols, CV_8UC1);
+  mask->segmented = area;
   reuse_or_create(soil->mm, depth.mm.rows, depth.mm.cols, CV_32FC1);
   if (area.size() != depth.mm.size()) {
     mask->values.setTo(ResidueMask::kUnknown);

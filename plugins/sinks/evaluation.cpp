@@ -38,21 +38,23 @@ std::string describe_mat(const cv::Mat& mat) {
          std::to_string(mat.channels()) + "-channel depth " + std::to_string(mat.depth());
 }
 
-json mask_counts(const cv::Mat& predicted, const cv::Mat& truth) {
+// The confusion counts over the pixels the stage segmented; "ignored" counts those
+// outside them and those whose truth is mixed.
+json mask_counts(const ResidueMask& mask, const cv::Mat& truth) {
+  const cv::Mat& predicted = mask.values;
   if (predicted.type() != CV_8UC1 || truth.type() != CV_8UC1 || predicted.size != truth.size) {
     throw Error("mask: expected an 8-bit 1-channel mask of the truth mask's size (" +
                 describe_mat(truth) + "), got " + describe_mat(predicted));
   }
-  std::int64_t tp = 0, fp = 0, fn = 0, tn = 0, unknown = 0, ignored = 0;
-  for (int y = 0; y < truth.rows; ++y) {
+  const cv::Rect image({0, 0}, truth.size());
+  const cv::Rect segmented = mask.segmented.empty() ? image : mask.segmented & image;
+  std::int64_t tp = 0, fp = 0, fn = 0, tn = 0, unknown = 0;
+  for (int y = segmented.y; y < segmented.y + segmented.height; ++y) {
     const auto* known = truth.ptr<std::uint8_t>(y);
     const auto* called = predicted.ptr<std::uint8_t>(y);
-    for (int x = 0; x < truth.cols; ++x) {
+    for (int x = segmented.x; x < segmented.x + segmented.width; ++x) {
       const bool truth_residue = known[x] == ResidueMask::kResidue;
-      if (!truth_residue && known[x] != ResidueMask::kSoil) {
-        ++ignored;
-        continue;
-      }
+      if (!truth_residue && known[x] != ResidueMask::kSoil) continue;
       const bool called_residue = called[x] == ResidueMask::kResidue;
       if (called[x] == ResidueMask::kUnknown) ++unknown;
       if (called_residue) {
@@ -62,6 +64,7 @@ json mask_counts(const cv::Mat& predicted, const cv::Mat& truth) {
       }
     }
   }
+  const std::int64_t ignored = static_cast<std::int64_t>(truth.total()) - tp - fp - fn - tn;
   return {{"tp", tp}, {"fp", fp},           {"fn", fn},
           {"tn", tn}, {"unknown", unknown}, {"ignored", ignored}};
 }
@@ -102,7 +105,7 @@ class Evaluation final : public Sink {
     const ResidueMask* mask =
         frame.input(kMask).empty() ? nullptr : &frame.input<ResidueMask>(kMask);
     line["mask"] =
-        mask != nullptr && truth_mask ? mask_counts(mask->values, truth->residue_mask) : json();
+        mask != nullptr && truth_mask ? mask_counts(*mask, truth->residue_mask) : json();
     if (!image_dir_.empty()) {
       const std::string name = image_name(info.frame_id);
       if (mask != nullptr) write_image(image_dir_ / "mask" / (name + ".png"), mask->values);

@@ -50,7 +50,19 @@ def read_truth(folder):
     return truth
 
 
+def segmented_region(shape):
+    """What every variant here segments: the chain's roi, the middle half of the image in
+    each direction, and 8 px around it (docs/segmentation.md, "The region segmented")."""
+    rows, cols = shape
+    top, left = (rows - rows // 2) // 2 - 8, (cols - cols // 2) // 2 - 8
+    return slice(max(top, 0), min(top + rows // 2 + 16, rows)), \
+        slice(max(left, 0), min(left + cols // 2 + 16, cols))
+
+
 def mask_counts(predicted, truth):
+    """Over the pixels segmented, as sinks.evaluation counts them."""
+    region = segmented_region(truth.shape)
+    predicted, truth = predicted[region], truth[region]
     known = (truth == 0) | (truth == 255)
     residue = predicted == 255
     truly = truth == 255

@@ -26,7 +26,7 @@ FRAMES = 40
 FPS = 10  # slow enough that several Modbus reads fall inside the run
 FRAME_REGISTER, STATUS_REGISTER, VALID = 4, 6, 1
 # The simulator's truth against the chain's median/plane of ~10^4 soil pixels with 1 mm
-# noise: the paper cases are within 0.2 mm (docs/accuracy.md); rough field soil with
+# noise: the paper cases are within 0.2 mm (docs/accuracy-paper-cases.md); rough field soil with
 # 4 mm relief, a plane read at a tool point, and a trimmed mean on heavy residue leave a
 # few mm between "the" soil surface and the one measured.
 TOLERANCE_MM = {"seeder": 1.0, "transplanter": 6.0, "tillage": 4.0}

@@ -17,6 +17,9 @@ struct ResidueMask : MessageOf<ResidueMask> {
   static constexpr std::uint8_t kResidue = 255;
 
   cv::Mat values;  // CV_8UC1
+  // The part the stage segmented (its region of interest and what it read around it);
+  // every pixel outside is kUnknown. Empty: the whole image.
+  cv::Rect segmented;
 
   std::string summary() const override;
 };
