@@ -104,8 +104,7 @@ class Evaluation final : public Sink {
     line["truth_soil_fraction"] = truth_mask ? json(soil_fraction(truth->residue_mask)) : json();
     const ResidueMask* mask =
         frame.input(kMask).empty() ? nullptr : &frame.input<ResidueMask>(kMask);
-    line["mask"] =
-        mask != nullptr && truth_mask ? mask_counts(*mask, truth->residue_mask) : json();
+    line["mask"] = mask != nullptr && truth_mask ? mask_counts(*mask, truth->residue_mask) : json();
     if (!image_dir_.empty()) {
       const std::string name = image_name(info.frame_id);
       if (mask != nullptr) write_image(image_dir_ / "mask" / (name + ".png"), mask->values);
