@@ -25,11 +25,13 @@ PLC_SERVER = os.path.join(SUPPORT, "plc_server.py")
 FRAMES = 40
 FPS = 10  # slow enough that several Modbus reads fall inside the run
 FRAME_REGISTER, STATUS_REGISTER, VALID = 4, 6, 1
-# The simulator's truth against the chain's median/plane of ~10^4 soil pixels with 1 mm
-# noise: the paper cases are within 0.2 mm (docs/accuracy-paper-cases.md); rough field soil with
-# 4 mm relief, a plane read at a tool point, and a trimmed mean on heavy residue leave a
-# few mm between "the" soil surface and the one measured.
-TOLERANCE_MM = {"seeder": 1.0, "transplanter": 6.0, "tillage": 4.0}
+# The simulator's truth (the ground's shape without its micro-relief) against the ground
+# fitted around the tool point. Measured (40 frames, max |error|): seeder 0.20 mm on case C;
+# tillage 0.57 mm and transplanter 1.84 mm on the field preset, whose 4 mm micro-relief
+# the fit follows under the tool and the truth leaves out (150 mm ahead of the axis for
+# the transplanter; docs/accuracy.md). The bounds are about twice that: noise stays
+# inside, a regression by a millimetre or more on the seeder and tillage does not.
+TOLERANCE_MM = {"seeder": 0.5, "transplanter": 3.5, "tillage": 1.2}
 
 
 def words_to_int32(high, low):
