@@ -31,8 +31,7 @@ class ColorIndexStage final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(
-        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
+    const ResidueInputs in = read_residue_inputs(frame, min_value_, output_.area(frame));
     thread_local cv::Mat residue;
     const IndexSplit split = index_.classify(in.bgr, in.untrusted, residue);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());

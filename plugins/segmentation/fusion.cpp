@@ -40,8 +40,7 @@ class Fusion final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(
-        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
+    const ResidueInputs in = read_residue_inputs(frame, min_value_, output_.area(frame));
     thread_local cv::Mat by_color, soil_color, height, by_height, unknown;
     const IndexSplit split = index_.classify(in.bgr, in.untrusted, by_color);
     notice_.report(frame.info().frame_id, !split.two_classes, split.text());

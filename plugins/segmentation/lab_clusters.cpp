@@ -143,8 +143,7 @@ class LabClusters final : public Transform {
         notice_(context.log) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(
-        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
+    const ResidueInputs in = read_residue_inputs(frame, min_value_, output_.area(frame));
     thread_local cv::Mat features, residue;
     thread_local std::vector<cv::Vec2f> sample;
     chroma_features(in.bgr, smoothing_px_, features);

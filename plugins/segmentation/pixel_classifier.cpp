@@ -30,8 +30,7 @@ class PixelClassifier final : public Transform {
         output_(context.params) {}
 
   void process(Frame& frame) override {
-    const ResidueInputs in = read_residue_inputs(
-        frame, min_value_, output_.area(frame.input<DepthImage>(kDepthInput).mm.size()));
+    const ResidueInputs in = read_residue_inputs(frame, min_value_, output_.area(frame));
     thread_local cv::Mat cells, residue;
     color_cells(in.bgr, cells);
     residue.create(cells.size(), CV_8UC1);

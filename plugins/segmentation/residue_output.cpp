@@ -116,6 +116,10 @@ cv::Rect ResidueOutput::area(cv::Size size) const {
   return roi_.around(size, RegionOfInterest::kMarginPx);
 }
 
+cv::Rect ResidueOutput::area(const Frame& frame) const {
+  return area(frame.input<DepthImage>(kDepthInput).mm.size());
+}
+
 void ResidueOutput::emit(Frame& frame, const cv::Rect& area, const cv::Mat& residue,
                          const cv::Mat& not_residue, const cv::Mat& unknown,
                          const cv::Mat& depth_mm) {

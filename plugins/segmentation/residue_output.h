@@ -72,6 +72,8 @@ class ResidueOutput {
   // pixels are segmented as they would be in a whole image. The outputs are unknown
   // outside it.
   cv::Rect area(cv::Size size) const;
+  // The same for the frame's depth input.
+  cv::Rect area(const Frame& frame) const;
 
   // `residue` (CV_8UC1, 255/0) is what the variant found in `area`, as the other images. Pixels
   // marked in `not_residue` (if not empty) are taken out of it first, so they cannot grow into
