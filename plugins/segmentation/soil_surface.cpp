@@ -146,10 +146,9 @@ void half_support(const cv::Mat& depth, const cv::Mat& missing, const cv::Mat& c
 // depth within the window, then the nearest of those). Residue narrower than the window
 // is gone from it; ground that slopes, curves gently or steps over more than a window is
 // kept as it is. NaN where no pixel within the window may be soil.
-void envelope(const cv::Mat& supported, int side, cv::Mat& surface) {
+void envelope(const cv::Mat& supported, const cv::Mat& window, cv::Mat& surface) {
   constexpr float kNoSurface = std::numeric_limits<float>::max();
   thread_local cv::Mat farthest;
-  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, {side, side});
   cv::dilate(supported, farthest, window);
   for (int row = 0; row < farthest.rows; ++row) {
     auto* f = farthest.ptr<float>(row);
@@ -229,10 +228,19 @@ void heights_above(const cv::Mat& half, const cv::Mat& depth, const cv::Mat& mis
   }
 }
 
+// The envelope's window on the half-resolution grid: odd, about envelope_px / 2 wide.
+cv::Mat envelope_window(double envelope_px) {
+  if (envelope_px <= 0) return {};
+  const int side = 2 * static_cast<int>(std::lround(envelope_px / 4)) + 1;
+  return cv::getStructuringElement(cv::MORPH_RECT, {side, side});
+}
+
 }  // namespace
 
 SoilSurface::SoilSurface(double height_mm, double surface_px, double envelope_px)
-    : height_mm_(height_mm), surface_px_(surface_px), envelope_px_(envelope_px) {}
+    : height_mm_(height_mm),
+      surface_px_(surface_px),
+      envelope_window_(envelope_window(envelope_px)) {}
 
 void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
                           const cv::Mat& candidates, cv::Mat& height_mm) const {
@@ -249,8 +257,8 @@ void SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
   cv::medianBlur(zeroed, depth, 3);
   half_support(depth, missing, candidates, supported);
 
-  if (envelope_px_ > 0) {
-    envelope(supported, 2 * static_cast<int>(std::lround(envelope_px_ / 4)) + 1, surface);
+  if (!envelope_window_.empty()) {
+    envelope(supported, envelope_window_, surface);
   } else {
     const std::optional<Plane> plane = farthest_plane(depth, missing, candidates);
     if (!plane) {

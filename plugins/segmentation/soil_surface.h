@@ -28,7 +28,7 @@ class SoilSurface {
  private:
   const double height_mm_;
   const double surface_px_;
-  const double envelope_px_;
+  const cv::Mat envelope_window_;  // empty: start from the plane
 };
 
 // The parameters of the stages that use it: `height_mm`, `surface_px` and `envelope_px`.
