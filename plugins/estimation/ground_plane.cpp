@@ -1,23 +1,24 @@
-// estimation.ground_plane: the ground under the tool -- a plane fitted to the soil points
-// around the tool's position, read there, with the ground's tilt.
+// estimation.ground_plane: the ground under the tool -- the soil surface around the tool's
+// position, fitted as a smooth piece of ground and read there, with the ground's tilt.
 //
-//   soil_depth ──► enough soil? ──► sampled rays (x', y') with depth Z, weighted by their
-//   nearness to the tool point ──► up to max_surfaces pieces of ground, each RANSAC
-//   (3-point planes, fixed seed, weighted) then least squares on its inliers, re-selected
-//   until stable, on what the earlier pieces left ──► the piece the tool stands on ──►
-//   distance at tool_point, tilt, spread = weighted RMS of the inlier residuals
+//   soil_depth ──► enough soil? ──► soil points (X, Y, Z) on a sampling grid ──►
+//   the ground's tilt: medians of the local slopes ──► the tool's level: the soil depths
+//   with that tilt taken out, from their median near the tool point to the nearest mode
+//   (mean shift) ──► a quadric surface fitted to the soil points within the outlier
+//   threshold of it (weighted least squares with Tukey's biweight, re-selected until it
+//   settles) ──► distance at tool_point,
+//   tilt, spread = weighted RMS of the inlier residuals
 //
-// The plane is written a X + b Y + c Z = 1 in the ToF camera frame (origin at the optical
-// centre), so along the ray of undistorted normalised coordinates (x', y') it lies at
-// Z = 1 / (a x' + b y' + c): 1/Z is linear in (x', y'), which come from the calibration
-// and carry no noise. Residuals are along Z, in mm.
+// Why in this order. A step in the ground shows as two levels with the same tilt; a plane
+// fitted freely can tilt to pass through both. The tilt taken from the medians of local
+// slopes (a step is a slope only along its edge) and the level found by its mode near the
+// tool keep the fit on the level the tool stands on. The quadric follows the curvature of
+// ridges and furrows, so the fit can weigh soil from farther away (`neighbourhood_mm`) and
+// average out clods and small relief.
 //
 // `neighbourhood_mm` weights each point by a Gaussian of its distance from the tool point
-// across the ground, so the ground around the tool decides and a ridge or furrow
-// elsewhere in the region does not tilt the fit; 0 weighs all points alike. Where the
-// ground steps, `max_surfaces` > 1 fits the pieces in turn, and the points within about
-// `tool_area_mm` of the tool point pick the one it stands on (the piece whose inliers
-// hold the most of them, by a Gaussian of that scale).
+// across the ground; 0 weighs all points alike. `tool_area_mm` is the scale of the soil
+// that decides which level the tool stands on; 0 lets all the soil decide.
 //
 // Tilts are slope angles: tilt_x_deg = atan(dZ/dY) (the ground turned
 // about the camera's x axis; positive when it is farther towards +y, the bottom of the
@@ -26,13 +27,11 @@
 //
 //   "estimate": {"type": "estimation.ground_plane",
 //                "params": {"tool_point": [0, 120], "neighbourhood_mm": 40,
-//                           "max_surfaces": 3, "tool_area_mm": 10}}
+//                           "tool_area_mm": 10, "outlier_threshold_mm": 3}}
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <random>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -53,14 +52,20 @@
 namespace tilth::estimation {
 namespace {
 
-// A bound only: re-fitting stops as soon as the inlier set no longer changes.
+// A bound only: re-fitting stops as soon as the depth at the tool point settles.
 constexpr int kMaxRefits = 10;
-constexpr std::size_t kScoreStep = 4;
+// A bound only: the mean shift stops when the level moves less than kLevelSettledMm.
+constexpr int kMaxLevelShifts = 30;
+constexpr double kLevelSettledMm = 1e-3;
+// Local slopes span this many grid steps: long enough that range noise moves them little,
+// short enough that few of them cross a step's edge.
+constexpr std::size_t kSlopeSpan = 3;
 // Points farther than 3.7 neighbourhoods from the tool point are left out of the fit.
 constexpr double kNegligibleWeight = 1e-3;
 const double kNegligibleExponent = -std::log(kNegligibleWeight);
-// Any fixed value: the same frame always gives the same surface.
-constexpr std::uint32_t kRansacSeed = 20240611;
+// The quadric's coordinates are (X, Y) from the tool point in units of kQuadricScaleMm,
+// so that its normal equations are well conditioned.
+constexpr double kQuadricScaleMm = 100.0;
 
 struct GridPixel {
   int row;
@@ -70,134 +75,145 @@ struct GridPixel {
 };
 
 struct SoilPoint {
-  double x;
+  double x;  // camera frame, mm
   double y;
   double z;       // optical-centre depth, mm
   double weight;  // in the fit: nearness to the tool point at the neighbourhood's scale
-  double vote;    // in choosing the tool's surface: nearness at the tool area's scale
+  double vote;    // in choosing the tool's level: nearness at the tool area's scale
 };
 
-// 1/Z as a function of (x', y'): the plane c + a x' + b y'.
-class Surface {
- public:
-  explicit Surface(const Eigen::Vector3d& cab) : cab_(cab) {}
+// The ground's slopes in the camera frame: Z = Z0 + dz_dx X + dz_dy Y.
+struct Tilt {
+  double dz_dx;
+  double dz_dy;
 
-  // The plane through three soil points, unless they are (nearly) collinear.
-  static std::optional<Surface> through(const SoilPoint& p, const SoilPoint& q,
-                                        const SoilPoint& r) {
-    Eigen::Matrix3d rays;
-    rays << 1, p.x, p.y, 1, q.x, q.y, 1, r.x, r.y;
-    // Normalised coordinates span about 1, so this is twice the triangle's area in them.
-    if (std::abs(rays.determinant()) < 1e-9) return std::nullopt;
-    return Surface(rays.partialPivLu().solve(Eigen::Vector3d(1 / p.z, 1 / q.z, 1 / r.z)));
+  double level(const SoilPoint& point) const { return point.z - dz_dx * point.x - dz_dy * point.y; }
+};
+
+// Z as a quadratic polynomial of (X, Y) about the tool point.
+class Quadric {
+ public:
+  using Vector = Eigen::Matrix<double, 6, 1>;
+
+  Quadric(cv::Vec2d origin_mm, double level, const Tilt& tilt) : origin_mm_(origin_mm) {
+    coefficients_ << level + tilt.dz_dx * origin_mm[0] + tilt.dz_dy * origin_mm[1],
+        tilt.dz_dx * kQuadricScaleMm, tilt.dz_dy * kQuadricScaleMm, 0, 0, 0;
   }
 
-  bool inlier(const SoilPoint& point, double threshold_mm) const {
-    const double m = inverse_depth(point.x, point.y);
-    return m > 0 && std::abs(point.z * m - 1) <= threshold_mm * m;  // |Z - 1/m| <= threshold
+  Vector terms(double x_mm, double y_mm) const {
+    const double u = (x_mm - origin_mm_[0]) / kQuadricScaleMm;
+    const double v = (y_mm - origin_mm_[1]) / kQuadricScaleMm;
+    Vector t;
+    t << 1, u, v, u * u, u * v, v * v;
+    return t;
   }
 
   double residual_mm(const SoilPoint& point) const {
-    return point.z - 1 / inverse_depth(point.x, point.y);
+    return point.z - terms(point.x, point.y).dot(coefficients_);
   }
 
-  // Z of the plane at camera-frame (X, Y) (c Z + a X + b Y = 1); not finite, or not
-  // positive, when the plane never gets there.
-  double depth_at(double x_mm, double y_mm) const {
-    return (1 - cab_[1] * x_mm - cab_[2] * y_mm) / cab_[0];
-  }
+  double depth_at_origin() const { return coefficients_[0]; }
+  double slope_x_at_origin() const { return coefficients_[1] / kQuadricScaleMm; }  // dZ/dX
+  double slope_y_at_origin() const { return coefficients_[2] / kQuadricScaleMm; }  // dZ/dY
 
-  double slope_x() const { return -cab_[1] / cab_[0]; }  // dZ/dX
-  double slope_y() const { return -cab_[2] / cab_[0]; }  // dZ/dY
+  // Weighted least squares on the points within `threshold_mm` of this surface, each also
+  // weighed by Tukey's biweight of its residual (1 on the surface, 0 at the threshold), so
+  // that the fringe of a neighbouring level does not pull the surface onto it; false (and
+  // unchanged) when they do not determine a quadric.
+  bool refit(const std::vector<SoilPoint>& points, double threshold_mm) {
+    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+    Vector right = Vector::Zero();
+    for (const SoilPoint& point : points) {
+      const Vector t = terms(point.x, point.y);
+      const double relative = (point.z - t.dot(coefficients_)) / threshold_mm;
+      if (std::abs(relative) > 1) continue;
+      const double biweight = (1 - relative * relative) * (1 - relative * relative);
+      const double weight = point.weight * biweight;
+      normal.selfadjointView<Eigen::Lower>().rankUpdate(t, weight);
+      right += weight * point.z * t;
+    }
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal.selfadjointView<Eigen::Lower>());
+    if (solver.info() != Eigen::Success ||
+        solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
+      return false;  // too few inliers, or all on a line
+    }
+    coefficients_ = solver.solve(right);
+    return true;
+  }
 
  private:
-  double inverse_depth(double x, double y) const { return cab_[0] + cab_[1] * x + cab_[2] * y; }
-
-  Eigen::Vector3d cab_;
+  cv::Vec2d origin_mm_;
+  Vector coefficients_;
 };
 
-// Weighted least squares of the residuals along Z: Z - 1/m ~= Z^2 m - Z near the plane
-// (m ~= 1/Z), which is linear in (c, a, b).
-std::optional<Surface> fit(const std::vector<SoilPoint>& points, const std::vector<bool>& inliers) {
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d right = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!inliers[i]) continue;
-    const SoilPoint& p = points[i];
-    const Eigen::Vector3d row = p.z * p.z * Eigen::Vector3d(1, p.x, p.y);
-    normal += p.weight * row * row.transpose();
-    right += p.weight * p.z * row;
-  }
-  const Eigen::LDLT<Eigen::Matrix3d> solver(normal);
-  if (solver.info() != Eigen::Success ||
-      solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
-    return std::nullopt;  // fewer than three inliers, or all on a line
-  }
-  return Surface(solver.solve(right));
+double median(std::vector<double>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
 }
 
-// Marks the inliers of `surface`; returns their weight and whether any flag changed.
-std::pair<double, bool> mark_inliers(const std::vector<SoilPoint>& points, const Surface& surface,
-                                     double threshold_mm, std::vector<bool>& inliers) {
-  double weight = 0.0;
-  bool changed = false;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const bool inlier = surface.inlier(points[i], threshold_mm);
-    changed = changed || inlier != inliers[i];
-    inliers[i] = inlier;
-    weight += inlier ? points[i].weight : 0.0;
+// The medians of the slopes of the triangles (p, p + kSlopeSpan to the right, p +
+// kSlopeSpan down) of soil grid points; nullopt without enough of them.
+std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t columns) {
+  thread_local std::vector<double> dz_dx;
+  thread_local std::vector<double> dz_dy;
+  dz_dx.clear();
+  dz_dy.clear();
+  const std::size_t down = kSlopeSpan * columns;
+  for (std::size_t i = 0; i + down < grid.size(); ++i) {
+    if (i % columns + kSlopeSpan >= columns) continue;
+    const SoilPoint& p = grid[i];
+    const SoilPoint& right = grid[i + kSlopeSpan];
+    const SoilPoint& below = grid[i + down];
+    if (!std::isfinite(p.z) || !std::isfinite(right.z) || !std::isfinite(below.z)) continue;
+    Eigen::Matrix2d across;
+    across << right.x - p.x, right.y - p.y, below.x - p.x, below.y - p.y;
+    const Eigen::Vector2d slopes =
+        across.partialPivLu().solve(Eigen::Vector2d(right.z - p.z, below.z - p.z));
+    dz_dx.push_back(slopes[0]);
+    dz_dy.push_back(slopes[1]);
   }
-  return {weight, changed};
+  if (dz_dx.size() < 3) return std::nullopt;
+  return Tilt{median(dz_dx), median(dz_dy)};
 }
 
-// Least squares on the inliers of `plane`, re-selected and re-fitted until they no longer
-// change. Leaves the final inliers marked.
-std::optional<Surface> refine(const std::vector<SoilPoint>& points, Surface plane,
-                              double threshold_mm, std::vector<bool>& inliers) {
-  inliers.assign(points.size(), false);
-  bool changed = mark_inliers(points, plane, threshold_mm, inliers).second;
-  for (int refit = 0; refit < kMaxRefits && changed; ++refit) {
-    const std::optional<Surface> better = fit(points, inliers);
-    if (!better) return std::nullopt;
-    plane = *better;
-    changed = mark_inliers(points, plane, threshold_mm, inliers).second;
+// The level (depth with the tilt taken out) the tool stands on: from the median of the
+// levels weighed by their votes, the mean shift (window +-threshold, fit weights) to the
+// nearest mode.
+double tool_level(const std::vector<SoilPoint>& points, const Tilt& tilt, double threshold_mm) {
+  thread_local std::vector<std::pair<double, double>> voted;  // level, vote
+  voted.clear();
+  double votes = 0.0;
+  for (const SoilPoint& point : points) {
+    if (point.vote < kNegligibleWeight) continue;
+    voted.emplace_back(tilt.level(point), point.vote);
+    votes += point.vote;
   }
-  return plane;
-}
-
-// Planes through three points drawn in proportion to their weight, scored by the weight of
-// their inliers among every kScoreStep-th point (a sample as good as all of them for
-// ranking the hypotheses: the best is refined on all).
-std::optional<Surface> ransac(const std::vector<SoilPoint>& points, int hypotheses,
-                              double threshold_mm) {
-  thread_local std::vector<double> cumulative;
-  cumulative.resize(points.size());
-  double total = 0.0;
-  for (std::size_t i = 0; i < points.size(); ++i) cumulative[i] = total += points[i].weight;
-  std::mt19937 random(kRansacSeed);
-  std::uniform_real_distribution<double> pick(0.0, total);
-  const auto draw = [&]() -> const SoilPoint& {
-    const auto at = std::upper_bound(cumulative.begin(), cumulative.end(), pick(random));
-    return points[std::min<std::size_t>(at - cumulative.begin(), points.size() - 1)];
-  };
-  std::optional<Surface> best;
-  double best_weight = 0.0;
-  for (int h = 0; h < hypotheses; ++h) {
-    const SoilPoint& p = draw();
-    const SoilPoint& q = draw();
-    const SoilPoint& r = draw();
-    const auto plane = Surface::through(p, q, r);
-    if (!plane) continue;
+  std::sort(voted.begin(), voted.end());
+  double level = voted.back().first;
+  double below = 0.0;
+  for (const auto& [candidate, vote] : voted) {
+    below += vote;
+    if (below >= votes / 2) {
+      level = candidate;
+      break;
+    }
+  }
+  for (int shift = 0; shift < kMaxLevelShifts; ++shift) {
     double weight = 0.0;
-    for (std::size_t i = 0; i < points.size(); i += kScoreStep) {
-      if (plane->inlier(points[i], threshold_mm)) weight += points[i].weight;
+    double sum = 0.0;
+    for (const SoilPoint& point : points) {
+      const double at = tilt.level(point);
+      if (std::abs(at - level) > threshold_mm) continue;
+      weight += point.weight;
+      sum += point.weight * at;
     }
-    if (weight > best_weight) {
-      best = plane;
-      best_weight = weight;
-    }
+    if (weight <= 0.0) break;
+    const double moved = sum / weight - level;
+    level += moved;
+    if (std::abs(moved) < kLevelSettledMm) break;
   }
-  return best;
+  return level;
 }
 
 double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
@@ -234,12 +250,13 @@ std::vector<GridPixel> sampling_grid(const DepthCameraCalibration& camera, const
   return grid;
 }
 
-// What fitting a frame's plane needs from its calibration.
+// What fitting a frame's ground needs from its calibration.
 struct Sampling {
   DepthCameraCalibration camera;
   cv::Size image_size;
   cv::Rect roi;
-  std::vector<GridPixel> grid;
+  std::vector<GridPixel> grid;  // row by row
+  std::size_t grid_columns;
 };
 
 class GroundPlaneEstimator final : public Transform {
@@ -253,8 +270,6 @@ class GroundPlaneEstimator final : public Transform {
         threshold_mm_(context.params.number("outlier_threshold_mm")),
         neighbourhood_mm_(context.params.number("neighbourhood_mm")),
         tool_area_mm_(context.params.number("tool_area_mm")),
-        max_surfaces_(static_cast<int>(context.params.integer("max_surfaces"))),
-        hypotheses_(static_cast<int>(context.params.integer("iterations"))),
         min_inlier_fraction_(context.params.number("min_inlier_fraction")),
         gates_(context.params),
         calibration_(
@@ -264,7 +279,8 @@ class GroundPlaneEstimator final : public Transform {
               const cv::Size size(rig.depth.width, rig.depth.height);
               if (region_.clipped_on(size)) log.warning(region_.clipping_note(size));
               const cv::Rect roi = region_.on(size);
-              return Sampling{rig.depth, size, roi, sampling_grid(rig.depth, roi, stride)};
+              return Sampling{rig.depth, size, roi, sampling_grid(rig.depth, roi, stride),
+                              static_cast<std::size_t>((roi.width + stride - 1) / stride)};
             }) {}
 
   void process(Frame& frame) override {
@@ -299,66 +315,70 @@ class GroundPlaneEstimator final : public Transform {
  private:
   void measure(const Sampling& sampling, const cv::Mat& soil_mm, GroundDistance& out) const {
     const DepthCameraCalibration& camera = sampling.camera;
+    thread_local std::vector<SoilPoint> grid;  // every grid pixel; z NaN where no soil
     thread_local std::vector<SoilPoint> points;
-    thread_local std::vector<bool> inliers;
+    grid.clear();
     points.clear();
     for (const GridPixel& pixel : sampling.grid) {
       const float depth = soil_mm.at<float>(pixel.row, pixel.col);
-      if (!std::isfinite(depth)) continue;
-      const double z = depth + camera.z_offset_mm;
+      const double z = depth + camera.z_offset_mm;  // NaN where no soil
       const double x = pixel.x * z;
       const double y = pixel.y * z;
+      grid.push_back({x, y, z, 0.0, 0.0});
+      if (!std::isfinite(depth)) continue;
       const double weight = nearness(x, y, neighbourhood_mm_);
       if (weight < kNegligibleWeight) continue;
-      points.push_back({pixel.x, pixel.y, z, weight, nearness(x, y, tool_area_mm_)});
+      points.push_back({x, y, z, weight, nearness(x, y, tool_area_mm_)});
     }
-    if (points.size() < 3) {
+    const std::optional<Tilt> tilt = ground_tilt(grid, sampling.grid_columns);
+    if (!tilt || points.size() < 6) {
       out.invalidate(InvalidCause::kTooLittleSoil,
-                     "too few soil points on the sampling grid: " + std::to_string(points.size()) +
-                         " < 3 (lower 'stride')");
+                     "too few soil points on the sampling grid to fit the ground (lower "
+                     "'stride')");
       return;
+    }
+    Quadric surface(tool_point_mm_, tool_level(points, *tilt, threshold_mm_), *tilt);
+    for (int refit = 0; refit < kMaxRefits; ++refit) {
+      const double before = surface.depth_at_origin();
+      if (!surface.refit(points, threshold_mm_)) {
+        out.invalidate(InvalidCause::kNotOneSurface,
+                       "no surface fits the soil points (too few inliers, or all on a line)");
+        return;
+      }
+      if (std::abs(surface.depth_at_origin() - before) < kLevelSettledMm) break;
     }
 
-    const std::optional<Surface> tool_surface = surface_under_tool(points, inliers);
-    if (!tool_surface) {
-      out.invalidate(InvalidCause::kNotOneSurface,
-                     "no surface fits the soil points (too few inliers, or all on a line)");
-      return;
-    }
-    const Surface& surface = *tool_surface;
-    const double inlier_weight = mark_inliers(points, surface, threshold_mm_, inliers).first;
+    double inlier_weight = 0.0;
+    double squares = 0.0;
     double votes = 0.0;
     double inlier_votes = 0.0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      votes += points[i].vote;
-      inlier_votes += inliers[i] ? points[i].vote : 0.0;
+    for (const SoilPoint& point : points) {
+      votes += point.vote;
+      const double residual_mm = surface.residual_mm(point);
+      if (std::abs(residual_mm) > threshold_mm_) continue;
+      inlier_votes += point.vote;
+      inlier_weight += point.weight;
+      squares += point.weight * residual_mm * residual_mm;
     }
     const double inlier_fraction = inlier_votes / votes;
     if (inlier_fraction < min_inlier_fraction_) {
       out.invalidate(InvalidCause::kNotOneSurface,
                      "no surface fits the soil: " + one_decimal(100.0 * inlier_fraction) +
                          " % of the soil points (by weight) lie within " +
-                         one_decimal(threshold_mm_) + " mm of the best one < " +
+                         one_decimal(threshold_mm_) + " mm of the tool's < " +
                          one_decimal(100.0 * min_inlier_fraction_) + " %");
       return;
     }
-    const double depth_at_tool = surface.depth_at(tool_point_mm_[0], tool_point_mm_[1]);
+    const double depth_at_tool = surface.depth_at_origin();
     if (!std::isfinite(depth_at_tool) || depth_at_tool <= 0) {
       out.invalidate(InvalidCause::kOutOfRange,
                      "the fitted surface does not lie in front of the camera at the tool point");
       return;
     }
-
-    double squares = 0.0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (!inliers[i]) continue;
-      const double residual_mm = surface.residual_mm(points[i]);
-      squares += points[i].weight * residual_mm * residual_mm;
-    }
     out.spread_mm = std::sqrt(squares / inlier_weight);
     out.distance_mm = depth_at_tool - camera.z_offset_mm;
-    out.tilt_x_deg = degrees(std::atan(surface.slope_y()));
-    out.tilt_y_deg = degrees(std::atan(surface.slope_x()));
+    out.tilt_x_deg = degrees(std::atan(surface.slope_y_at_origin()));
+    out.tilt_y_deg = degrees(std::atan(surface.slope_x_at_origin()));
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
   }
@@ -374,46 +394,12 @@ class GroundPlaneEstimator final : public Transform {
     return exponent > kNegligibleExponent ? 0.0 : std::exp(-exponent);
   }
 
-  // Up to max_surfaces surfaces, each fitted (RANSAC, then least squares) to the soil
-  // points the earlier ones left over; the tool's is the one whose inliers hold the most
-  // of the points around the tool point (votes). One surface: the best fit of them all.
-  std::optional<Surface> surface_under_tool(const std::vector<SoilPoint>& points,
-                                            std::vector<bool>& inliers) const {
-    thread_local std::vector<SoilPoint> left;
-    left = points;
-    std::optional<Surface> chosen;
-    double chosen_votes = -1.0;
-    for (int found = 0; found < max_surfaces_ && left.size() >= 3; ++found) {
-      const std::optional<Surface> guess = ransac(left, hypotheses_, threshold_mm_);
-      const std::optional<Surface> fitted =
-          guess ? refine(left, *guess, threshold_mm_, inliers) : std::nullopt;
-      if (!fitted) break;
-      double votes = 0.0;
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < left.size(); ++i) {
-        if (inliers[i]) {
-          votes += left[i].vote;
-        } else {
-          left[kept++] = left[i];
-        }
-      }
-      left.resize(kept);
-      if (votes > chosen_votes) {
-        chosen = fitted;
-        chosen_votes = votes;
-      }
-    }
-    return chosen;
-  }
-
   const RegionOfInterest region_;
   const cv::Vec2d tool_point_mm_;
   const SoilRequirement requirement_;
   const double threshold_mm_;
   const double neighbourhood_mm_;
   const double tool_area_mm_;
-  const int max_surfaces_;
-  const int hypotheses_;
   const double min_inlier_fraction_;
   const PlausibilityGates gates_;
   FrameCalibration<Sampling> calibration_;
@@ -424,7 +410,7 @@ class GroundPlaneEstimator final : public Transform {
 StageDescriptor describe_ground_plane() {
   StageDescriptor d;
   d.type = "estimation.ground_plane";
-  d.summary = "ground distance at the tool and ground tilt from a robust plane fit to the soil";
+  d.summary = "ground distance at the tool and ground tilt from a robust fit of the soil surface";
   d.inputs = {PortSpec::of<DepthImage>("soil_depth", "depth of the soil pixels, NaN elsewhere"),
               PlausibilityGates::color_port()};
   d.outputs = {PortSpec::of<GroundDistance>(
@@ -442,22 +428,16 @@ StageDescriptor describe_ground_plane() {
           .in_unit("mm")
           .describe("soil points weigh by a Gaussian (this sigma) of their distance from the "
                     "tool point; 0 = all alike"),
-      ParamSpec::integer("max_surfaces", 1)
-          .range(1, 8)
-          .describe(
-              "ground pieces fitted in turn (steps, ridges); the one the tool stands on wins"),
       ParamSpec::number("tool_area_mm", 0.0)
           .range(0, 10000)
           .in_unit("mm")
-          .describe("the ground within about this distance of the tool point picks its piece; "
-                    "0 = the largest piece"),
+          .describe("the soil within about this distance of the tool point picks the level "
+                    "it stands on (steps); 0 = all the soil"),
       ParamSpec::number("outlier_threshold_mm", 10.0)
           .range(0.1, 1000)
           .in_unit("mm")
-          .describe("soil points farther than this from the surface (along Z) are outliers"),
-      ParamSpec::integer("iterations", 64)
-          .range(1, 10000)
-          .describe("RANSAC hypotheses (3-point planes) tried before the least-squares re-fits"),
+          .describe("soil points farther than this from the surface (along Z) are outliers, "
+                    "and levels farther apart are told apart"),
       ParamSpec::number("min_inlier_fraction", 0.5)
           .range(0, 1)
           .describe("below this fraction of the soil points (weighed by their votes) on the "
