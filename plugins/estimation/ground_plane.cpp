@@ -29,6 +29,7 @@
 //                "params": {"tool_point": [0, 120], "neighbourhood_mm": 40,
 //                           "tool_area_mm": 10, "outlier_threshold_mm": 3}}
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -56,12 +57,14 @@ namespace {
 constexpr int kMaxRefits = 10;
 // A bound only: the mean shift stops when the level moves less than kLevelSettledMm.
 constexpr int kMaxLevelShifts = 30;
-constexpr double kLevelSettledMm = 1e-3;
+constexpr double kLevelSettledMm = 1e-2;
 // Local slopes span this many grid steps: long enough that range noise moves them little,
 // short enough that few of them cross a step's edge.
 constexpr std::size_t kSlopeSpan = 3;
-// Points farther than 3.7 neighbourhoods from the tool point are left out of the fit.
-constexpr double kNegligibleWeight = 1e-3;
+// Slopes from every kSlopeRowStep-th row of the grid: their medians need thousands, not all.
+constexpr std::size_t kSlopeRowStep = 2;
+// Points farther than 3 neighbourhoods from the tool point are left out of the fit.
+constexpr double kNegligibleWeight = 1e-2;
 const double kNegligibleExponent = -std::log(kNegligibleWeight);
 // The quadric's coordinates are (X, Y) from the tool point in units of kQuadricScaleMm,
 // so that its normal equations are well conditioned.
@@ -121,23 +124,43 @@ class Quadric {
   // that the fringe of a neighbouring level does not pull the surface onto it; false (and
   // unchanged) when they do not determine a quadric.
   bool refit(const std::vector<SoilPoint>& points, double threshold_mm) {
-    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
-    Vector right = Vector::Zero();
+    // The normal equations' lower triangle, row by row, and right-hand side, summed in plain
+    // arrays: a fixed 6x6 rank update per point costs several times more through Eigen.
+    std::array<double, 21> lower{};
+    std::array<double, 6> right{};
+    const double c0 = coefficients_[0], c1 = coefficients_[1], c2 = coefficients_[2];
+    const double c3 = coefficients_[3], c4 = coefficients_[4], c5 = coefficients_[5];
+    const double per_scale = 1.0 / kQuadricScaleMm;
+    const double per_threshold = 1.0 / threshold_mm;
     for (const SoilPoint& point : points) {
-      const Vector t = terms(point.x, point.y);
-      const double relative = (point.z - t.dot(coefficients_)) / threshold_mm;
+      const double u = (point.x - origin_mm_[0]) * per_scale;
+      const double v = (point.y - origin_mm_[1]) * per_scale;
+      const std::array<double, 6> t{1.0, u, v, u * u, u * v, v * v};
+      const double fitted = c0 + c1 * u + c2 * v + c3 * t[3] + c4 * t[4] + c5 * t[5];
+      const double relative = (point.z - fitted) * per_threshold;
       if (std::abs(relative) > 1) continue;
       const double biweight = (1 - relative * relative) * (1 - relative * relative);
       const double weight = point.weight * biweight;
-      normal.selfadjointView<Eigen::Lower>().rankUpdate(t, weight);
-      right += weight * point.z * t;
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < 6; ++i) {
+        const double wt = weight * t[i];
+        right[i] += wt * point.z;
+        for (std::size_t j = 0; j <= i; ++j) lower[k++] += wt * t[j];
+      }
     }
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal.selfadjointView<Eigen::Lower>());
+    Eigen::Matrix<double, 6, 6> normal;
+    for (std::size_t i = 0, k = 0; i < 6; ++i) {
+      for (std::size_t j = 0; j <= i; ++j, ++k) {
+        normal(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = lower[k];
+        normal(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = lower[k];
+      }
+    }
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
     if (solver.info() != Eigen::Success ||
         solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
       return false;  // too few inliers, or all on a line
     }
-    coefficients_ = solver.solve(right);
+    coefficients_ = solver.solve(Vector(right.data()));
     return true;
   }
 
@@ -162,16 +185,17 @@ std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t 
   const std::size_t down = kSlopeSpan * columns;
   for (std::size_t i = 0; i + down < grid.size(); ++i) {
     if (i % columns + kSlopeSpan >= columns) continue;
+    if ((i / columns) % kSlopeRowStep != 0) continue;
     const SoilPoint& p = grid[i];
     const SoilPoint& right = grid[i + kSlopeSpan];
     const SoilPoint& below = grid[i + down];
     if (!std::isfinite(p.z) || !std::isfinite(right.z) || !std::isfinite(below.z)) continue;
-    Eigen::Matrix2d across;
-    across << right.x - p.x, right.y - p.y, below.x - p.x, below.y - p.y;
-    const Eigen::Vector2d slopes =
-        across.partialPivLu().solve(Eigen::Vector2d(right.z - p.z, below.z - p.z));
-    dz_dx.push_back(slopes[0]);
-    dz_dy.push_back(slopes[1]);
+    // dZ = dz_dx dX + dz_dy dY along both sides, by Cramer's rule.
+    const double x1 = right.x - p.x, y1 = right.y - p.y, z1 = right.z - p.z;
+    const double x2 = below.x - p.x, y2 = below.y - p.y, z2 = below.z - p.z;
+    const double determinant = x1 * y2 - y1 * x2;  // about the triangle's area: never near 0
+    dz_dx.push_back((z1 * y2 - y1 * z2) / determinant);
+    dz_dy.push_back((x1 * z2 - z1 * x2) / determinant);
   }
   if (dz_dx.size() < 3) return std::nullopt;
   return Tilt{median(dz_dx), median(dz_dy)};
@@ -181,12 +205,15 @@ std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t 
 // levels weighed by their votes, the mean shift (window +-threshold, fit weights) to the
 // nearest mode.
 double tool_level(const std::vector<SoilPoint>& points, const Tilt& tilt, double threshold_mm) {
+  thread_local std::vector<double> levels;
   thread_local std::vector<std::pair<double, double>> voted;  // level, vote
+  levels.clear();
   voted.clear();
   double votes = 0.0;
   for (const SoilPoint& point : points) {
+    levels.push_back(tilt.level(point));
     if (point.vote < kNegligibleWeight) continue;
-    voted.emplace_back(tilt.level(point), point.vote);
+    voted.emplace_back(levels.back(), point.vote);
     votes += point.vote;
   }
   std::sort(voted.begin(), voted.end());
@@ -202,11 +229,10 @@ double tool_level(const std::vector<SoilPoint>& points, const Tilt& tilt, double
   for (int shift = 0; shift < kMaxLevelShifts; ++shift) {
     double weight = 0.0;
     double sum = 0.0;
-    for (const SoilPoint& point : points) {
-      const double at = tilt.level(point);
-      if (std::abs(at - level) > threshold_mm) continue;
-      weight += point.weight;
-      sum += point.weight * at;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (std::abs(levels[i] - level) > threshold_mm) continue;
+      weight += points[i].weight;
+      sum += points[i].weight * levels[i];
     }
     if (weight <= 0.0) break;
     const double moved = sum / weight - level;
@@ -391,7 +417,7 @@ class GroundPlaneEstimator final : public Transform {
     const double dx = x_mm - tool_point_mm_[0];
     const double dy = y_mm - tool_point_mm_[1];
     const double exponent = (dx * dx + dy * dy) / (2 * scale_mm * scale_mm);
-    return exponent > kNegligibleExponent ? 0.0 : std::exp(-exponent);
+    return exponent > kNegligibleExponent ? 0.0 : std::exp(static_cast<float>(-exponent));
   }
 
   const RegionOfInterest region_;

@@ -27,7 +27,8 @@ class PlausibilityGates {
   static PortSpec color_port();
 
   // Why the registered colour in `roi` cannot tell residue from soil (mostly clipped
-  // white or black, or flat), or nothing when it can.
+  // white or black, or flat), or nothing when it can; judged on every other pixel of
+  // every other row.
   std::optional<std::string> unusable_color(const RegisteredColor& color, cv::Rect roi) const;
 
   // Invalidates a measured, valid `out` whose distance, spread or confidence is implausible.

@@ -40,7 +40,7 @@ std::int64_t count_finite(const cv::Mat& depth_mm, const cv::Rect& region) {
   for (int row = region.y; row < region.y + region.height; ++row) {
     const float* depth = depth_mm.ptr<float>(row);
     for (int col = region.x; col < region.x + region.width; ++col) {
-      count += std::isfinite(depth[col]) ? 1 : 0;
+      count += depth[col] - depth[col] == 0.0f ? 1 : 0;  // false for NaN and infinities
     }
   }
   return count;
