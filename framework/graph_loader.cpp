@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <regex>
+#include <set>
 #include <unordered_map>
 
 #include "framework/diagnostics.h"
@@ -91,6 +92,18 @@ class Loader {
     chain_.pop_back();
   }
 
+  // A --var that no file of the graph declares would change nothing: a typing slip.
+  void check_command_line_variables() {
+    const std::vector<std::string> declared(declared_variables_.begin(), declared_variables_.end());
+    for (const auto& [name, value] : command_line_variables_) {
+      if (declared_variables_.contains(name)) continue;
+      diagnostics_.add({"command line", "--var " + name},
+                       "no file of the graph declares a variable '" + name + "'" +
+                           did_you_mean(name, declared) + " (declared: " + quoted_list(declared) +
+                           ")");
+    }
+  }
+
   void apply(const std::vector<Setting>& settings) {
     for (const auto& setting : settings) {
       const Location where{"command line", "--set " + setting.key};
@@ -154,6 +167,7 @@ class Loader {
     if (document.contains("variables")) {
       if (document["variables"].is_object()) {
         variables = document["variables"];
+        for (const auto& [key, value] : variables.items()) declared_variables_.insert(key);
       } else {
         diagnostics_.add(root.child("variables"), "expected an object of name: value");
       }
@@ -194,6 +208,21 @@ class Loader {
     }
     result.append(begin, text.cend());
     return result;
+  }
+
+  // Relative paths in a value resolve against the file's directory, unless the value
+  // starts with a variable set on the command line (`--var log=run.csv`): that path was
+  // typed in the working directory.
+  fs::path base_dir(const json& value, const fs::path& file_dir) const {
+    static const std::regex kLeadingReference(R"(^\$\{([A-Za-z_][A-Za-z0-9_]*)\})");
+    if (!value.is_string()) return file_dir;
+    const std::string text = value.get<std::string>();
+    std::smatch leading;
+    if (std::regex_search(text, leading, kLeadingReference) &&
+        command_line_variables_.contains(leading[1])) {
+      return fs::current_path();
+    }
+    return file_dir;
   }
 
   json lookup(const std::string& name, const json& variables, const Location& where) {
@@ -315,8 +344,10 @@ class Loader {
       }
       for (const auto& [param, value] : body["params"].items()) {
         const Location param_where = params_where.child(param);
-        node->params[param] = {
-            nlohmann::json(substitute(value, variables, param_where)), param_where, dir, {}};
+        node->params[param] = {nlohmann::json(substitute(value, variables, param_where)),
+                               param_where,
+                               base_dir(value, dir),
+                               {}};
       }
     }
   }
@@ -432,6 +463,7 @@ class Loader {
   std::unordered_map<std::string, std::size_t> node_index_;  // name -> index in graph_.nodes
   std::vector<std::string> chain_;
   std::map<std::string, json> command_line_variables_;
+  std::set<std::string> declared_variables_;
 };
 
 }  // namespace
@@ -448,6 +480,7 @@ GraphSpec load_graph(const fs::path& file, const GraphOverrides& overrides) {
   Diagnostics diagnostics;
   Loader loader(overrides, diagnostics);
   loader.load(file, "", json::object(), Location{});
+  if (diagnostics.empty()) loader.check_command_line_variables();
   if (diagnostics.empty()) loader.apply(overrides.params);
   diagnostics.throw_if_any();
   return loader.take(file);

@@ -153,6 +153,46 @@ TEST(GraphLoader, CommandLineOverridesParamsVariablesAndRuntime) {
   const GraphSpec with_vars = load_graph(file, {{}, {{"n", "7"}}});
   EXPECT_EQ(node(with_vars, "out").params.at("file").value, "run-7.txt");
   EXPECT_EQ(node(with_vars, "src").params.at("count").value, 7);
+  // The path starts with the file's own variable: relative to the file's directory.
+  EXPECT_EQ(node(with_vars, "out").params.at("file").base_dir, file.parent_path());
+}
+
+TEST(GraphLoader, ACommandLineVariableNoFileDeclaresIsAnError) {
+  TempDir dir;
+  const auto chain = dir.write("chain.json", R"({
+    "variables": {"calibration": ""},
+    "nodes": {"in": {"type": "test.record", "params": {"file": "${calibration}"}}}
+  })");
+  const auto file = dir.write("machine.json", R"({
+    "variables": {"plc_address": "192.168.10.2"},
+    "include": [{"file": "chain.json", "as": "chain"}],
+    "nodes": {"src": {"type": "test.counter", "params": {"count": 1}}}
+  })");
+  // Declared in the included file: accepted.
+  EXPECT_NO_THROW(load_graph(file, {{}, {{"calibration", "rig.json"}}}));
+  EXPECT_EQ(load_error(file, {{}, {{"plc_adress", "10.0.0.2"}}}),
+            "command line:--var plc_adress: no file of the graph declares a variable "
+            "'plc_adress'; did you mean 'plc_address'? (declared: 'calibration', "
+            "'plc_address')");
+}
+
+// `--var log=run.csv` names a file where the user typed it, as `--set` does.
+TEST(GraphLoader, APathStartingWithACommandLineVariableIsRelativeToTheWorkingDirectory) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({
+    "variables": {"log": "default.csv", "folder": "logs"},
+    "nodes": {"src": {"type": "test.counter"},
+              "out": {"type": "test.record", "params": {"file": "${log}"}},
+              "also": {"type": "test.record", "params": {"file": "${folder}/${log}"}}}
+  })");
+  const GraphSpec defaults = load_graph(file);
+  EXPECT_EQ(node(defaults, "out").params.at("file").base_dir, file.parent_path());
+
+  const GraphSpec typed = load_graph(file, {{}, {{"log", "run.csv"}}});
+  EXPECT_EQ(node(typed, "out").params.at("file").value, "run.csv");
+  EXPECT_EQ(node(typed, "out").params.at("file").base_dir, std::filesystem::current_path());
+  EXPECT_EQ(node(typed, "also").params.at("file").value, "logs/run.csv");
+  EXPECT_EQ(node(typed, "also").params.at("file").base_dir, file.parent_path());
 }
 
 TEST(GraphLoader, ReportsEveryProblemAtOnce) {
