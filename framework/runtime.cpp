@@ -192,10 +192,16 @@ class Runtime::Impl {
     for (auto& spec : graph_.nodes) {
       auto node = std::make_unique<Node>();
       node->spec = std::move(spec);
-      StageContext context{node->spec.name, node->spec.params, Logger(node->spec.name),
+      StageContext context{node->spec.name,
+                           node->spec.params,
+                           Logger(node->spec.name),
                            [this] { return metrics(); },
                            [this, lost = node.get()](std::uint64_t frames, const std::string& why) {
                              record_loss(*lost, frames, why);
+                           },
+                           [this, name = node->spec.name](const std::string& why) {
+                             log(LogLevel::kWarning, name, "ending the run: " + why);
+                             stop();
                            }};
       try {
         node->instance = registry.create(node->type(), context);

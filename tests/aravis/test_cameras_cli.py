@@ -228,7 +228,7 @@ class FakeCamerasGraph(unittest.TestCase):
             rows_path = os.path.join(directory, "rows.csv")
             log = open(os.path.join(directory, "stderr.txt"), "w+")
             run = subprocess.Popen(
-                [TILTH, "run", graph, "--quiet", "--var", "depth_camera=" + DEPTH.address,
+                [TILTH, "run", graph, "--var", "depth_camera=" + DEPTH.address,
                  "--var", "color_camera=" + COLOR.address, "--var", "log=" + rows_path],
                 stdout=subprocess.DEVNULL, stderr=log)
             time.sleep(8)

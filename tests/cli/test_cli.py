@@ -155,6 +155,26 @@ class Run(unittest.TestCase):
     def test_sigint_stops_cleanly(self):
         self.stop_with(signal.SIGINT)
 
+    def test_a_closed_standard_output_ends_the_run(self):
+        # `tilth run GRAPH | head -1`: the reader takes one line and goes.
+        process = subprocess.Popen(
+            [TILTH, "run", PLANE, "--set", "camera.fps=100", "--set", "print.every=1"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            first = process.stdout.readline()
+            process.stdout.close()
+            err = process.stderr.read(1 << 20)
+            process.wait(timeout=30)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        self.assertEqual(first, "frame 0: raw ToF 640x480\n")
+        self.assertEqual(process.returncode, 0, err)
+        self.assertIn("print: ending the run: standard output is closed (Broken pipe): nothing "
+                      "more can be printed", err)
+        self.assertRegex(err, r"\d+ frames completed")
+
 
 if __name__ == "__main__":
     unittest.main()

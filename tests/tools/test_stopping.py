@@ -133,7 +133,7 @@ class Run(unittest.TestCase):
         graph = os.path.join(tmp, "graph.json")
         with open(graph, "w") as f:
             json.dump({"nodes": nodes, "edges": edges}, f)
-        tool = Tool(tmp, "run", graph, "--quiet")
+        tool = Tool(tmp, "run", graph)
         tool.wait_for(lambda: count_lines(self.csv) > 100, "100 CSV rows")
         return tool
 

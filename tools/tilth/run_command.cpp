@@ -1,6 +1,7 @@
 // `tilth run`: runs a graph until its sources end, --frames is reached, or SIGINT /
 // SIGTERM asks it to stop (frames in flight finish, sinks flush, exit code 0; 3 when a
 // stage lost data).
+#include <csignal>
 #include <iostream>
 
 #include <unistd.h>
@@ -30,7 +31,7 @@ const std::string kUsage =
         "ended but a stage could not store data (a full disk; each such stage is named).\n\n") +
     kGraphOptionsHelp +
     "  --frames N              stop after N frames\n"
-    "  --quiet                 no status line and no summary\n"
+    "  --quiet                 warnings and errors only: no info lines, status line or summary\n"
     "  --verbose               debug log lines\n";
 
 // A year at 30 frames/s is 1e9 frames; a thousand times that is no typing slip.
@@ -40,6 +41,10 @@ constexpr std::uint64_t kMaxFrames = 1'000'000'000'000;
 
 int run_command(int argc, char** argv) {
   tools::install_stop_handlers("run");
+  // A closed standard output (`tilth run ... | head -1`) makes writes fail with EPIPE,
+  // which sinks.console answers by ending the run cleanly, instead of killing the
+  // process with files half written.
+  std::signal(SIGPIPE, SIG_IGN);
 
   const CommandLine line(argc, argv, 2, {"--set", "--var", "--frames"},
                          {"--help", "--quiet", "--verbose"});
@@ -52,6 +57,7 @@ int run_command(int argc, char** argv) {
     return kExitUsage;
   }
   if (line.flag("--verbose")) set_log_level(LogLevel::kDebug);
+  if (line.flag("--quiet")) set_log_level(LogLevel::kWarning);
   RunLimits limits;
   limits.max_frames = line.count("--frames", 1, kMaxFrames);
   const std::string file = line.positional()[0];

@@ -1,5 +1,6 @@
 // What a stage is constructed with: its node name, checked parameters, a logger, access
-// to the running pipeline's metrics, and where to report data it could not store.
+// to the running pipeline's metrics, where to report data it could not store, and how to
+// end the run when it cannot go on.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +24,10 @@ struct StageContext {
   // with data lost (docs/runtime.md, "Lost data"). Thread-safe.
   std::function<void(std::uint64_t frames, const std::string& why)> report_data_loss =
       [](std::uint64_t, const std::string&) {};
+  // A stage that cannot go on at all (the reader of its output has gone: a closed pipe)
+  // ends the run as a stop signal would: sources stop, frames in flight finish, every sink
+  // flushes. The runtime logs the node and `why`. Thread-safe.
+  std::function<void(const std::string& why)> end_run = [](const std::string&) {};
 };
 
 }  // namespace tilth
