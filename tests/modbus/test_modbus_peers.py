@@ -70,7 +70,7 @@ class TilthRun:
         self.stderr_path = os.path.join(tmp, "stderr.txt")
         self.stderr_file = open(self.stderr_path, "w")
         self.process = subprocess.Popen(
-            [TILTH, "run", self.graph, "--quiet"], stdout=subprocess.DEVNULL,
+            [TILTH, "run", self.graph], stdout=subprocess.DEVNULL,
             stderr=self.stderr_file, env=dict(os.environ, TILTH_PLUGIN_PATH=PLUGIN_DIR))
 
     def rows(self):
