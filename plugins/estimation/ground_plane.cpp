@@ -103,16 +103,8 @@ class Quadric {
         tilt.dz_dx * kQuadricScaleMm, tilt.dz_dy * kQuadricScaleMm, 0, 0, 0;
   }
 
-  Vector terms(double x_mm, double y_mm) const {
-    const double u = (x_mm - origin_mm_[0]) / kQuadricScaleMm;
-    const double v = (y_mm - origin_mm_[1]) / kQuadricScaleMm;
-    Vector t;
-    t << 1, u, v, u * u, u * v, v * v;
-    return t;
-  }
-
   double residual_mm(const SoilPoint& point) const {
-    return point.z - terms(point.x, point.y).dot(coefficients_);
+    return point.z - fitted(terms(point.x, point.y));
   }
 
   double depth_at_origin() const { return coefficients_[0]; }
@@ -128,16 +120,10 @@ class Quadric {
     // arrays: a fixed 6x6 rank update per point costs several times more through Eigen.
     std::array<double, 21> lower{};
     std::array<double, 6> right{};
-    const double c0 = coefficients_[0], c1 = coefficients_[1], c2 = coefficients_[2];
-    const double c3 = coefficients_[3], c4 = coefficients_[4], c5 = coefficients_[5];
-    const double per_scale = 1.0 / kQuadricScaleMm;
     const double per_threshold = 1.0 / threshold_mm;
     for (const SoilPoint& point : points) {
-      const double u = (point.x - origin_mm_[0]) * per_scale;
-      const double v = (point.y - origin_mm_[1]) * per_scale;
-      const std::array<double, 6> t{1.0, u, v, u * u, u * v, v * v};
-      const double fitted = c0 + c1 * u + c2 * v + c3 * t[3] + c4 * t[4] + c5 * t[5];
-      const double relative = (point.z - fitted) * per_threshold;
+      const Terms t = terms(point.x, point.y);
+      const double relative = (point.z - fitted(t)) * per_threshold;
       if (std::abs(relative) > 1) continue;
       const double biweight = (1 - relative * relative) * (1 - relative * relative);
       const double weight = point.weight * biweight;
@@ -165,6 +151,22 @@ class Quadric {
   }
 
  private:
+  using Terms = std::array<double, 6>;
+
+  Terms terms(double x_mm, double y_mm) const {
+    constexpr double kPerScale = 1.0 / kQuadricScaleMm;
+    const double u = (x_mm - origin_mm_[0]) * kPerScale;
+    const double v = (y_mm - origin_mm_[1]) * kPerScale;
+    return {1.0, u, v, u * u, u * v, v * v};
+  }
+
+  double fitted(const Terms& t) const {
+    double z = 0.0;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      z += coefficients_[static_cast<Eigen::Index>(i)] * t[i];
+    return z;
+  }
+
   cv::Vec2d origin_mm_;
   Vector coefficients_;
 };
