@@ -184,20 +184,20 @@ std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t 
   thread_local std::vector<double> dz_dy;
   dz_dx.clear();
   dz_dy.clear();
-  const std::size_t down = kSlopeSpan * columns;
-  for (std::size_t i = 0; i + down < grid.size(); ++i) {
-    if (i % columns + kSlopeSpan >= columns) continue;
-    if ((i / columns) % kSlopeRowStep != 0) continue;
-    const SoilPoint& p = grid[i];
-    const SoilPoint& right = grid[i + kSlopeSpan];
-    const SoilPoint& below = grid[i + down];
-    if (!std::isfinite(p.z) || !std::isfinite(right.z) || !std::isfinite(below.z)) continue;
-    // dZ = dz_dx dX + dz_dy dY along both sides, by Cramer's rule.
-    const double x1 = right.x - p.x, y1 = right.y - p.y, z1 = right.z - p.z;
-    const double x2 = below.x - p.x, y2 = below.y - p.y, z2 = below.z - p.z;
-    const double determinant = x1 * y2 - y1 * x2;  // about the triangle's area: never near 0
-    dz_dx.push_back((z1 * y2 - y1 * z2) / determinant);
-    dz_dy.push_back((x1 * z2 - z1 * x2) / determinant);
+  const std::size_t rows = grid.size() / columns;
+  for (std::size_t row = 0; row + kSlopeSpan < rows; row += kSlopeRowStep) {
+    for (std::size_t col = 0; col + kSlopeSpan < columns; ++col) {
+      const SoilPoint& p = grid[row * columns + col];
+      const SoilPoint& right = grid[row * columns + col + kSlopeSpan];
+      const SoilPoint& below = grid[(row + kSlopeSpan) * columns + col];
+      if (!std::isfinite(p.z) || !std::isfinite(right.z) || !std::isfinite(below.z)) continue;
+      // dZ = dz_dx dX + dz_dy dY along both sides, by Cramer's rule.
+      const double x1 = right.x - p.x, y1 = right.y - p.y, z1 = right.z - p.z;
+      const double x2 = below.x - p.x, y2 = below.y - p.y, z2 = below.z - p.z;
+      const double determinant = x1 * y2 - y1 * x2;  // about the triangle's area: never near 0
+      dz_dx.push_back((z1 * y2 - y1 * z2) / determinant);
+      dz_dy.push_back((x1 * z2 - z1 * x2) / determinant);
+    }
   }
   if (dz_dx.size() < 3) return std::nullopt;
   return Tilt{median(dz_dx), median(dz_dy)};
