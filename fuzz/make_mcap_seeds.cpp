@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "mcap_writer.h"
+#include "mcap/mcap_writer.h"
 
 namespace fs = std::filesystem;
 using namespace tilth::mcap;

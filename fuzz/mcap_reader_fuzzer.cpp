@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "fuzz_input_file.h"
-#include "mcap_reader.h"
+#include "mcap/mcap_reader.h"
 #include "tilth/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -24,6 +24,7 @@
 
 #include "framework/graph_loader.h"
 #include "framework/stage_registry.h"
+#include "source_tree.h"
 #include "tilth/calibration.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_distance.h"
@@ -50,7 +51,7 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace tilth {
 namespace {
 
-const std::string kCalibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+const std::string kCalibration = testing::paper_rig_path().string();
 
 // OpenCV's own allocator, counting the image buffers it hands out.
 class CountingMatAllocator final : public cv::MatAllocator {
@@ -94,7 +95,8 @@ StageInstance make(const std::string& type, nlohmann::json params = nlohmann::js
 StageInstance chain_node(const std::string& name) {
   static const GraphSpec chain = [] {
     const char* const chosen = std::getenv("TILTH_CHAIN_GRAPH");
-    return load_graph(chosen ? chosen : TILTH_SOURCE_DIR "/graphs/measurement-chain.json");
+    return load_graph(chosen ? std::filesystem::path(chosen)
+                             : testing::source_path("graphs/measurement-chain.json"));
   }();
   for (const NodeSpec& node : chain.nodes) {
     if (node.name != name) continue;

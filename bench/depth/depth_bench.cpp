@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "projection.h"
+#include "source_tree.h"
 #include "tilth/frame.h"
 #include "tilth/messages/raw_tof_frame.h"
 
@@ -13,7 +14,7 @@ namespace tilth::depth {
 namespace {
 
 void BM_DepthProjection(benchmark::State& state) {
-  const std::string calibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+  const std::string calibration = testing::paper_rig_path().string();
   const StageContext context{
       "projection", Params(nlohmann::json{{"calibration", calibration}}), Logger("projection"), {}};
   const std::unique_ptr<Stage> stage = describe_projection().create(context);

@@ -9,6 +9,7 @@
 #include <benchmark/benchmark.h>
 
 #include "estimators.h"
+#include "source_tree.h"
 #include "stage_harness.h"
 #include "synthetic_ground.h"
 #include "tilth/messages/depth_image.h"
@@ -16,7 +17,7 @@
 namespace tilth::estimation {
 namespace {
 
-const std::string kPaperRig = std::string(TILTH_SOURCE_DIR) + "/calib/paper_rig.calib.json";
+const std::string kPaperRig = testing::paper_rig_path().string();
 
 std::vector<std::shared_ptr<const Message>> soil_frame() {
   testing::GroundScene scene;

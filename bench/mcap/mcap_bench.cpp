@@ -29,14 +29,15 @@
 #include <benchmark/benchmark.h>
 #include <nlohmann/json.hpp>
 
-#include "compression.h"
-#include "crc32.h"
 #include "framework/graph_loader.h"
 #include "framework/graph_validator.h"
 #include "framework/runtime.h"
 #include "framework/stage_registry.h"
-#include "mcap_reader.h"
-#include "raw_image.h"
+#include "mcap/compression.h"
+#include "mcap/crc32.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/raw_image.h"
+#include "source_tree.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -49,7 +50,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::string kCalibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+const std::string kCalibration = testing::paper_rig_path().string();
 constexpr int kRenderedPairs = 8;
 constexpr int kRecordedPairs = 90;  // as fast as possible
 constexpr int kLivePairs = 300;     // 10 s at 30 pairs/s

@@ -9,6 +9,7 @@
 #include "projection.h"
 #include "projective.h"
 #include "row_kernels.h"
+#include "source_tree.h"
 #include "tilth/frame.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
@@ -17,7 +18,7 @@
 namespace tilth::registration {
 namespace {
 
-const std::string kCalibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+const std::string kCalibration = testing::paper_rig_path().string();
 
 std::unique_ptr<Stage> make(const StageDescriptor& descriptor, nlohmann::json params) {
   params["calibration"] = kCalibration;

@@ -16,7 +16,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/hal/intrin.hpp>
 
-#include "lens_model.h"
+#include "camera_geometry/lens_model.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/frame_calibration.h"

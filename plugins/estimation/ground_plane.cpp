@@ -37,8 +37,8 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <opencv2/calib3d.hpp>
 
+#include "camera_geometry/lens_model.h"
 #include "estimators.h"
 #include "plausibility.h"
 #include "soil_region.h"
@@ -258,22 +258,20 @@ std::string size_text(cv::Size size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
-// Every stride-th pixel of the region, with its ray, computed once.
+// Every stride-th pixel of the region, with its ray, computed once. `where` names the
+// calibration's distortion in an error.
 std::vector<GridPixel> sampling_grid(const DepthCameraCalibration& camera, const cv::Rect& roi,
-                                     int stride) {
-  std::vector<cv::Point2f> pixels;
+                                     int stride, const std::string& where) {
+  std::vector<cv::Point2d> pixels;
   for (int row = roi.y; row < roi.y + roi.height; row += stride) {
-    for (int col = roi.x; col < roi.x + roi.width; col += stride) {
-      pixels.emplace_back(static_cast<float>(col), static_cast<float>(row));
-    }
+    for (int col = roi.x; col < roi.x + roi.width; col += stride) pixels.emplace_back(col, row);
   }
-  std::vector<cv::Point2f> rays;
-  cv::undistortPoints(pixels, rays, camera.camera_matrix(), camera.distortion);
+  const std::vector<cv::Point2d> rays = lens::undistort(camera, pixels, where);
   std::vector<GridPixel> grid;
   grid.reserve(pixels.size());
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    grid.push_back(
-        {static_cast<int>(pixels[i].y), static_cast<int>(pixels[i].x), rays[i].x, rays[i].y});
+    grid.push_back({static_cast<int>(pixels[i].y), static_cast<int>(pixels[i].x),
+                    static_cast<float>(rays[i].x), static_cast<float>(rays[i].y)});
   }
   return grid;
 }
@@ -307,8 +305,10 @@ class GroundPlaneEstimator final : public Transform {
               const cv::Size size(rig.depth.width, rig.depth.height);
               if (region_.clipped_on(size)) log.warning(region_.clipping_note(size));
               const cv::Rect roi = region_.on(size);
-              return Sampling{rig.depth, size, roi, sampling_grid(rig.depth, roi, stride),
-                              static_cast<std::size_t>((roi.width + stride - 1) / stride)};
+              return Sampling{
+                  rig.depth, size, roi,
+                  sampling_grid(rig.depth, roi, stride, rig.origin + ":/depth_camera/distortion"),
+                  static_cast<std::size_t>((roi.width + stride - 1) / stride)};
             }) {}
 
   void process(Frame& frame) override {

@@ -21,10 +21,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "ground_truth_message.h"
-#include "mcap_reader.h"
-#include "raw_image.h"
-#include "recording_layout.h"
+#include "mcap/ground_truth_message.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/raw_image.h"
+#include "mcap/recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"

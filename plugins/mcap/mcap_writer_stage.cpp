@@ -20,10 +20,10 @@
 #include <functional>
 #include <limits>
 
-#include "ground_truth_message.h"
-#include "mcap_writer.h"
-#include "raw_image.h"
-#include "recording_layout.h"
+#include "mcap/ground_truth_message.h"
+#include "mcap/mcap_writer.h"
+#include "mcap/raw_image.h"
+#include "mcap/recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"

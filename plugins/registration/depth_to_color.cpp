@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "lens_model.h"
+#include "camera_geometry/lens_model.h"
 
 namespace tilth::registration {
 namespace {

@@ -13,7 +13,7 @@
 #include <immintrin.h>
 #endif
 
-#include "lens_model.h"
+#include "camera_geometry/lens_model.h"
 #include "row_kernels.h"
 #include "tilth/kernel_level.h"
 

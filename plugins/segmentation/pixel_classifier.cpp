@@ -13,8 +13,8 @@
 //   "segment": {"type": "segmentation.pixel_classifier", "params": {"model": "straw.yml.gz"}}
 #include <opencv2/core.hpp>
 
-#include "classifier_model.h"
-#include "pixel_features.h"
+#include "pixel_classifier/classifier_model.h"
+#include "pixel_classifier/pixel_features.h"
 #include "residue_output.h"
 #include "tilth/plugin.h"
 #include "variants.h"

@@ -13,10 +13,11 @@
 // is rendered per frame.
 #include <chrono>
 #include <cmath>
+#include <string>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "camera_geometry/lens_model.h"
 #include "ray_caster.h"
 #include "scene_preset.h"
 #include "tilth/calibration.h"
@@ -36,12 +37,13 @@ constexpr std::int64_t kColorLagNs = 400'000;  // the colour camera fires 0.4 ms
 // The reflectance at which `noise_mm` holds when the noise depends on reflectance.
 constexpr double kReferenceReflectance = 0.4;
 
-// Normalised, undistorted ray directions (z = 1) of pixel positions of a camera.
-cv::Mat ray_directions(const CameraIntrinsics& camera, const std::vector<cv::Point2f>& pixels) {
-  std::vector<cv::Point2f> normalised;
-  cv::undistortPoints(pixels, normalised, camera.camera_matrix(),
-                      std::vector<double>(camera.distortion.begin(), camera.distortion.end()));
-  return cv::Mat(normalised, true).reshape(2, static_cast<int>(pixels.size()));
+// Normalised, undistorted ray directions (z = 1) of pixel positions of a camera, CV_32FC2;
+// `where` names the calibration's distortion in an error.
+cv::Mat ray_directions(const CameraIntrinsics& camera, const std::vector<cv::Point2d>& pixels,
+                       const std::string& where) {
+  cv::Mat rays;
+  cv::Mat(lens::undistort(camera, pixels, where), false).convertTo(rays, CV_32FC2);
+  return rays;
 }
 
 int bayer_code(PixelFormat format) {
@@ -144,25 +146,25 @@ class SceneSource final : public Source {
 
  private:
   void prepare_rays() {
-    std::vector<cv::Point2f> centres;
-    std::vector<cv::Point2f> corners;
+    std::vector<cv::Point2d> centres;
+    std::vector<cv::Point2d> corners;
     for (int v = 0; v < rig_.depth.height; ++v) {
       for (int u = 0; u < rig_.depth.width; ++u) {
-        centres.emplace_back(static_cast<float>(u), static_cast<float>(v));
-        for (const float dv : {-0.25f, 0.25f}) {
-          for (const float du : {-0.25f, 0.25f}) corners.emplace_back(u + du, v + dv);
+        centres.emplace_back(u, v);
+        for (const double dv : {-0.25, 0.25}) {
+          for (const double du : {-0.25, 0.25}) corners.emplace_back(u + du, v + dv);
         }
       }
     }
-    tof_centre_rays_ = ray_directions(rig_.depth, centres);
-    tof_corner_rays_ = ray_directions(rig_.depth, corners);
-    std::vector<cv::Point2f> colour_pixels;
+    const std::string depth_distortion = rig_.origin + ":/depth_camera/distortion";
+    tof_centre_rays_ = ray_directions(rig_.depth, centres, depth_distortion);
+    tof_corner_rays_ = ray_directions(rig_.depth, corners, depth_distortion);
+    std::vector<cv::Point2d> colour_pixels;
     for (int v = 0; v < rig_.color.height; ++v) {
-      for (int u = 0; u < rig_.color.width; ++u) {
-        colour_pixels.emplace_back(static_cast<float>(u), static_cast<float>(v));
-      }
+      for (int u = 0; u < rig_.color.width; ++u) colour_pixels.emplace_back(u, v);
     }
-    colour_rays_ = ray_directions(rig_.color, colour_pixels);
+    colour_rays_ =
+        ray_directions(rig_.color, colour_pixels, rig_.origin + ":/color_camera/distortion");
     // The colour camera in the ToF frame: P_d = R^T (P_c - T).
     colour_rotation_ = rig_.depth_to_color_r.t();
     colour_origin_ = -(colour_rotation_ * rig_.depth_to_color_t_mm);

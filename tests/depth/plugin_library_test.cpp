@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "framework/stage_registry.h"
+#include "source_tree.h"
 #include "tilth/error.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -17,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kPaperRig = fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const fs::path kPaperRig = testing::paper_rig_path();
 
 StageContext context_for(const fs::path& calibration) {
   return {"depth",

@@ -15,7 +15,9 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "calibration_file.h"
 #include "projection.h"
+#include "source_tree.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
@@ -31,29 +33,9 @@ using nlohmann::json;
 
 constexpr double kMm = 1e-3;
 
-const fs::path kPaperRig = fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const fs::path kPaperRig = testing::paper_rig_path();
 
-json paper_rig() {
-  std::ifstream in(kPaperRig);
-  return json::parse(in);
-}
-
-// A calibration file of this test's own, removed at the end of the test.
-class CalibrationFile {
- public:
-  explicit CalibrationFile(const json& document)
-      : path_(fs::temp_directory_path() /
-              ("tilth_depth_" +
-               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-               ".calib.json")) {
-    std::ofstream(path_) << document.dump(2);
-  }
-  ~CalibrationFile() { fs::remove(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using testing::CalibrationFile;
 
 std::unique_ptr<Transform> make_projection(const fs::path& calibration,
                                            int saturated_gray = 65535) {
@@ -124,7 +106,7 @@ TEST(DepthProjection, Eq1AtTheCentreAndTheFourCorners) {
 }
 
 TEST(DepthProjection, ZMeasureSubtractsOnlyTheOffsets) {
-  json rig = paper_rig();
+  json rig = testing::paper_rig_document();
   rig["depth_camera"]["depth_measure"] = "z";
   rig["depth_camera"]["gray_offset_mm"] = 4.5;
   const CalibrationFile file(rig);
@@ -171,7 +153,7 @@ TEST(DepthProjection, TheCamerasScaleAndOffsetWinOverTheFile) {
 
   RawTofFrame scale_only = uniform_frame(20000);
   scale_only.scale_mm = 0.025;
-  json rig = paper_rig();
+  json rig = testing::paper_rig_document();
   rig["depth_camera"]["gray_offset_mm"] = 7.0;
   const CalibrationFile file(rig);
   const auto with_file_offset = project(*make_projection(file.path()), scale_only);
@@ -200,7 +182,7 @@ TEST(DepthProjection, DistortionIsUndoneBeforeTheFactor) {
   for (const Case c :
        {Case{0.62L, 0.45L, 600, 450}, Case{-0.55L, -0.41L, 25, 20}, Case{0.05L, -0.30L, 330, 95}}) {
     const cv::Point2d distorted = distort(k, c.x, c.y);
-    json rig = paper_rig();
+    json rig = testing::paper_rig_document();
     rig["depth_camera"]["distortion"] = {k[0], k[1], k[2], k[3], k[4]};
     rig["depth_camera"]["cx"] = static_cast<double>(c.u - f * distorted.x);
     rig["depth_camera"]["cy"] = static_cast<double>(c.v - f * distorted.y);
@@ -221,7 +203,7 @@ TEST(DepthProjection, DistortionIsUndoneBeforeTheFactor) {
 TEST(DepthProjection, AnyImageWidthAndRowLayoutGiveEq1) {
   // 13 x 3 pixels (not a whole number of SIMD vectors), as a continuous image and as a
   // view into a larger one (rows apart in memory); principal point (6, 1).
-  json rig = paper_rig();
+  json rig = testing::paper_rig_document();
   rig["depth_camera"]["width"] = 13;
   rig["depth_camera"]["height"] = 3;
   rig["depth_camera"]["cx"] = 6.0;
@@ -282,14 +264,14 @@ TEST(DepthProjection, AFrameOfAnotherPixelTypeIsRefused) {
 }
 
 TEST(DepthProjection, ABadCalibrationIsRefusedAtConstructionWithTheFieldNamed) {
-  json zero_focal = paper_rig();
+  json zero_focal = testing::paper_rig_document();
   zero_focal["depth_camera"]["fx"] = 0;
   const CalibrationFile zero_focal_file(zero_focal);
   EXPECT_EQ(construction_error(zero_focal_file.path()),
             zero_focal_file.path().string() + ":/depth_camera/fx: expected a number > 0, got 0");
 
   // k1 = -2 folds the image's outer part back onto itself: no inverse there.
-  json folded = paper_rig();
+  json folded = testing::paper_rig_document();
   folded["depth_camera"]["distortion"] = {-2.0, 0, 0, 0, 0};
   const CalibrationFile folded_file(folded);
   EXPECT_EQ(construction_error(folded_file.path())
@@ -376,7 +358,7 @@ TEST(DepthProjection, NoCalibrationAnywhereIsAnErrorSayingSo) {
 // A file named overrides the frame's calibration, never silently: one warning per
 // calibration carried, naming what differs.
 TEST(DepthProjection, ANamedFileOverridesTheFramesCalibrationLoudly) {
-  json other = paper_rig();
+  json other = testing::paper_rig_document();
   other["depth_camera"]["gray_to_mm"] = 0.025;
   const CalibrationFile carried_file(other);
   const auto carried =

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "estimators.h"
+#include "source_tree.h"
 #include "stage_harness.h"
 #include "synthetic_ground.h"
 #include "tilth/log.h"
@@ -25,8 +26,7 @@ using nlohmann::json;
 using testing::GroundScene;
 using testing::TransformHarness;
 
-const std::filesystem::path kPaperRig =
-    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const std::filesystem::path kPaperRig = testing::paper_rig_path();
 const cv::Rect kDefaultRoi(160, 120, 320, 240);  // the middle half of 640x480
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "estimators.h"
+#include "source_tree.h"
 #include "stage_harness.h"
 #include "synthetic_ground.h"
 #include "tilth/error.h"
@@ -32,8 +33,7 @@ using nlohmann::json;
 using testing::GroundScene;
 using testing::TransformHarness;
 
-const std::filesystem::path kPaperRig =
-    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const std::filesystem::path kPaperRig = testing::paper_rig_path();
 constexpr double kTiltToleranceDeg = 0.1;
 constexpr double kDistanceToleranceMm = 0.1;
 

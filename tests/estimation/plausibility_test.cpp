@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "estimators.h"
+#include "source_tree.h"
 #include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
@@ -21,8 +22,7 @@ namespace {
 using nlohmann::json;
 using testing::TransformHarness;
 
-const std::filesystem::path kPaperRig =
-    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const std::filesystem::path kPaperRig = testing::paper_rig_path();
 const cv::Rect kDefaultRoi(160, 120, 320, 240);  // the middle half of 640x480
 
 std::shared_ptr<DepthImage> depth_message(const cv::Mat& mm) {

@@ -9,10 +9,10 @@
 #include <cstring>
 #include <fstream>
 
+#include "mcap/mcap_reader.h"
+#include "mcap/mcap_recording.h"
+#include "mcap/mcap_writer.h"
 #include "mcap_fixture.h"
-#include "mcap_reader.h"
-#include "mcap_recording.h"
-#include "mcap_writer.h"
 #include "tilth/error.h"
 
 namespace tilth::testing {

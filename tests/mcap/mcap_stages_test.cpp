@@ -11,10 +11,10 @@
 #include <chrono>
 #include <fstream>
 
+#include "mcap/mcap_reader.h"
+#include "mcap/mcap_recording.h"
+#include "mcap/raw_image.h"
 #include "mcap_fixture.h"
-#include "mcap_reader.h"
-#include "mcap_recording.h"
-#include "raw_image.h"
 
 namespace tilth::testing {
 namespace {

@@ -12,9 +12,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "mcap_reader.h"
-#include "mcap_recording.h"
-#include "mcap_writer.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/mcap_recording.h"
+#include "mcap/mcap_writer.h"
 #include "temp_dir.h"
 #include "tilth/error.h"
 

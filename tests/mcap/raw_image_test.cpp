@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "raw_image.h"
+#include "mcap/raw_image.h"
 #include "tilth/error.h"
 
 namespace tilth::testing {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "framework/stage_registry.h"
+#include "source_tree.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
@@ -20,7 +21,7 @@ TEST(RegistrationPlugin, TheLibraryProvidesTheProjectiveStage) {
   ASSERT_NE(entry, nullptr);
   EXPECT_EQ(entry->plugin, "registration");
 
-  const std::string calibration = TILTH_SOURCE_DIR "/calib/paper_rig.calib.json";
+  const std::string calibration = testing::paper_rig_path().string();
   const StageContext context{"registration",
                              Params(nlohmann::json{{"calibration", calibration},
                                                    {"occlusion_tolerance_mm", 10.0},

@@ -23,11 +23,13 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calibration_file.h"
 #include "depth_to_color.h"
 #include "projective.h"
 #include "reference_geometry.h"
 #include "roi/region_of_interest.h"
 #include "row_kernels.h"
+#include "source_tree.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
 #include "tilth/messages/color_image.h"
@@ -45,29 +47,9 @@ using ref::Real;
 constexpr double kMappingPx = 0.01;
 constexpr double kPi = 3.14159265358979323846;
 
-const fs::path kPaperRig = fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const fs::path kPaperRig = testing::paper_rig_path();
 
-json paper_rig() {
-  std::ifstream in(kPaperRig);
-  return json::parse(in);
-}
-
-// A calibration file of this test's own, removed at the end of the test.
-class CalibrationFile {
- public:
-  explicit CalibrationFile(const json& document)
-      : path_(fs::temp_directory_path() /
-              ("tilth_registration_" +
-               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-               ".calib.json")) {
-    std::ofstream(path_) << document.dump(2);
-  }
-  ~CalibrationFile() { fs::remove(path_); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using testing::CalibrationFile;
 
 // R = Rz(z) Ry(y) Rx(x), angles in degrees.
 json rotation(double x_deg, double y_deg, double z_deg) {
@@ -284,12 +266,12 @@ std::vector<std::shared_ptr<const RegisteredColor>> expect_every_level_matches_t
 TEST(ProjectiveRegistration, TiltedPlaneMatchesTheReferenceProjection) {
   // The colour camera sees most of the ToF image: all but a band on the side away from
   // the baseline.
-  expect_every_level_matches_the_reference(paper_rig(), kPaperRig, coordinate_image(), 250000,
-                                           "paper rig, tilted plane");
+  expect_every_level_matches_the_reference(testing::paper_rig_document(), kPaperRig,
+                                           coordinate_image(), 250000, "paper rig, tilted plane");
 }
 
 TEST(ProjectiveRegistration, RotatedRigWithLensDistortionMatchesTheReferenceProjection) {
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["R"] = rotation(4, -6, 2);
   document["depth_to_color"]["T_mm"] = {45.0, -8.0, 5.0};
   document["depth_camera"]["distortion"] = {-0.12, 0.03, 0.0008, -0.0005, 0.0};
@@ -305,7 +287,7 @@ TEST(ProjectiveRegistration, ImagesOfNoWholeVectorsMatchTheReferenceToTheirLastP
   // covers: the last partial vector and the last colour pixels are read and written
   // exactly, and nothing beyond them is. With the colour camera on the left, the ToF
   // image's right edge is in its view.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["T_mm"] = {-45.0, 0.0, 0.0};
   document["depth_camera"]["width"] = 613;
   document["color_camera"]["width"] = 1279;
@@ -331,7 +313,7 @@ TEST(ProjectiveRegistration, AnInstructionSetTheCpuDoesNotRunIsRefused) {
 }
 
 TEST(ProjectiveRegistration, PixelsOutsideTheColourImageAreFlaggedAndBlack) {
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["color_camera"]["fx"] = 1800.0;  // a narrower colour view than the ToF's
   document["color_camera"]["fy"] = 1800.0;
   const CalibrationFile file(document);
@@ -349,7 +331,7 @@ TEST(ProjectiveRegistration, PixelsOutsideTheColourImageAreFlaggedAndBlack) {
 // Without a file named, the stage registers with the calibration the depth image carries:
 // a rig turned and moved registers exactly as with its file named.
 TEST(ProjectiveRegistration, TheDepthsCarriedCalibrationIsUsed) {
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["T_mm"] = {-38.0, 12.0, 6.0};
   const CalibrationFile file(document);
   const ref::Rig rig = ref::rig_from(document);
@@ -368,7 +350,7 @@ TEST(ProjectiveRegistration, PointsBeyondTheDistortionsFoldAreOutsideNotFoldedIn
   // Barrel distortion r (1 + k1 r^2) turns back at r^2 = -1 / (3 k1); with the colour
   // camera turned 35 degrees, ToF pixels up to 67 degrees off its axis exist, and the
   // polynomial maps some of them back into the image.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   const Real k1 = -0.15L;
   document["color_camera"]["distortion"] = {static_cast<double>(k1), 0, 0, 0, 0};
   document["depth_to_color"]["R"] = rotation(0, 35, 0);
@@ -505,11 +487,11 @@ void expect_occlusion_found(const BoxOcclusion& box, int min_occluded) {
 
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForThePaperRig) {
   // Colour camera 45 mm to -x: strip from 83 to 100 mm, 16 pixels by 113.
-  expect_occlusion_found(occlusion_by_a_box(paper_rig()), 1200);
+  expect_occlusion_found(occlusion_by_a_box(testing::paper_rig_document()), 1200);
 }
 
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheColourCameraOnTheOtherSide) {
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["T_mm"] = {-45.0, 0.0, 0.0};
   expect_occlusion_found(occlusion_by_a_box(document), 1200);
 }
@@ -517,7 +499,7 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheColourCameraOnTheOt
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForARotatedDiagonalRig) {
   // The box top's samples reach the colour image as a turned lattice; z-buffer cells one
   // depth pixel wide left holes in it here, and the plane behind them got the box's colour.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["R"] = rotation(3, -4, 2);
   document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
   expect_occlusion_found(occlusion_by_a_box(document), 1200);
@@ -527,7 +509,7 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheIma
   // Colour camera 150 mm behind and 60 mm to -x: its epipole lies inside the ToF image
   // (pixel 517, 240), so the parallax runs radially from there rather than along one
   // direction; strip from 83 to 93 mm.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["T_mm"] = {60.0, 0.0, 150.0};
   expect_occlusion_found(occlusion_by_a_box(document), 500);
 }
@@ -535,7 +517,7 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheIma
 TEST(ProjectiveRegistration, ARegionIsRegisteredAsInTheWholeImage) {
   // The rotated diagonal rig: the box hides plane in rows other than its own, so a band
   // that holds hidden plane but not all of the box needs the z-buffer of every row.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["R"] = rotation(3, -4, 2);
   document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
   const CalibrationFile file(document);
@@ -610,7 +592,7 @@ TEST(ProjectiveRegistration, EachBayerPatternGivesBackAKnownColour) {
   // offset reads green as red and blue.
   const cv::Mat uniform(1024, 1280, CV_8UC3, cv::Scalar(30, 120, 210));
   const auto stage = make_registration(kPaperRig);
-  const ref::Rig rig = ref::rig_from(paper_rig());
+  const ref::Rig rig = ref::rig_from(testing::paper_rig_document());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
   for (const PixelFormat format : kBayerFormats) {
     const auto out = register_color(*stage, depth, mosaic(uniform, format), format);
@@ -626,7 +608,7 @@ TEST(ProjectiveRegistration, NearestSamplingOfAMosaicReadsTheQuadNearestThePoint
   // Every 2x2 quad of a mosaic holds one red, one blue and two greens, whichever pixel it
   // starts on: with the two green sites at 100 and 51, each registered pixel is (blue,
   // (100 + 51 + 1) / 2, red) exactly, for every pattern and every phase of the quad.
-  const ref::Rig rig = ref::rig_from(paper_rig());
+  const ref::Rig rig = ref::rig_from(testing::paper_rig_document());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
   for (const auto& [format, level] : every_pattern_at_every_level()) {
     SCOPED_TRACE(level);
@@ -660,7 +642,7 @@ TEST(ProjectiveRegistration, BayerRgbAndMonoInputAgreeWithBgrForASmoothImage) {
           cv::saturate_cast<std::uint8_t>(200 - 0.12 * y));
     }
   }
-  const ref::Rig rig = ref::rig_from(paper_rig());
+  const ref::Rig rig = ref::rig_from(testing::paper_rig_document());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
   // Bilinear: demosaicing reproduces a linear ramp exactly; this image's curvature is at
   // most 100 / 60^2 = 0.03 levels per pixel^2, far below a level over the 1-pixel
@@ -706,7 +688,7 @@ TEST(ProjectiveRegistration, RgbAndMonoInputReadTheBgrPixelAtEveryLevel) {
   cv::Mat rgb, blue;
   cv::cvtColor(noise, rgb, cv::COLOR_BGR2RGB);
   cv::extractChannel(noise, blue, 0);
-  const ref::Rig rig = ref::rig_from(paper_rig());
+  const ref::Rig rig = ref::rig_from(testing::paper_rig_document());
   const cv::Mat depth = plane_depth(rig, depth_rays(rig), 518, tilted_normal());
   for (const std::string& level : levels()) {
     SCOPED_TRACE(level);
@@ -734,7 +716,7 @@ TEST(ProjectiveRegistration, BilinearSamplingFollowsARampBetweenPixels) {
                                            static_cast<std::uint8_t>(4 * (v - 400)), 0);
     }
   }
-  const json document = paper_rig();
+  const json document = testing::paper_rig_document();
   const ref::Rig rig = ref::rig_from(document);
   const auto rays = depth_rays(rig);
   const cv::Mat depth = plane_depth(rig, rays, 518, tilted_normal());
@@ -824,7 +806,7 @@ LinearisationError linearisation_error(const json& document, const fs::path& fil
 }
 
 TEST(ProjectiveRegistration, PapersLinearisedEqs4And5AgainstTheExactMappingForTheShippedRig) {
-  const json document = paper_rig();
+  const json document = testing::paper_rig_document();
   const LinearisationError e = linearisation_error(document, kPaperRig, 518);
   EXPECT_LT(e.exact_vs_reference_px, kMappingPx);
   // With R = I and T_z = 0 the third row of W is (0, 0, 1, 0) and eqs. 4-5 are exact but
@@ -846,7 +828,7 @@ TEST(ProjectiveRegistration, PapersLinearisationFailsForARotatedRig) {
   // The same rig turned 3 degrees about the ToF's y axis, a plausible mounting error:
   // the third row of W is no longer (0, 0, 1, 0) and dropping its division costs pixels
   // at the image sides even with the optical-centre depth.
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["depth_to_color"]["R"] = rotation(0, 3, 0);
   const CalibrationFile file(document);
   const LinearisationError e = linearisation_error(document, file.path(), 518);
@@ -888,7 +870,7 @@ TEST(ProjectiveRegistration, InputsThatDoNotFitTheCalibrationAreRefused) {
 }
 
 TEST(ProjectiveRegistration, ABadCalibrationIsRefusedAtConstructionWithTheFieldNamed) {
-  json document = paper_rig();
+  json document = testing::paper_rig_document();
   document["color_camera"]["fy"] = 0;
   const CalibrationFile file(document);
   try {

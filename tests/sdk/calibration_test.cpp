@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "source_tree.h"
 #include "temp_dir.h"
 #include "tilth/error.h"
 
@@ -14,8 +15,7 @@ namespace {
 
 using nlohmann::json;
 
-const std::filesystem::path kPaperRig =
-    std::filesystem::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
+const std::filesystem::path kPaperRig = testing::paper_rig_path();
 
 json paper_rig_json() {
   std::ifstream in(kPaperRig);

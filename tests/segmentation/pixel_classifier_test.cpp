@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "classifier_model.h"
 #include "painted_frame.h"
-#include "pixel_features.h"
+#include "pixel_classifier/classifier_model.h"
+#include "pixel_classifier/pixel_features.h"
 #include "segmenter_training.h"
 #include "temp_dir.h"
 #include "variants.h"

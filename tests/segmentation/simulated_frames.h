@@ -8,11 +8,11 @@
 
 #include "framework/stage_registry.h"
 #include "registered_frames.h"
+#include "source_tree.h"
 
 namespace tilth::segmentation {
 
-inline const std::string kCalibration =
-    std::string(TILTH_SOURCE_DIR) + "/calib/paper_rig.calib.json";
+inline const std::string kCalibration = testing::paper_rig_path().string();
 
 inline std::vector<train_segmenter::RegisteredFrame> simulated_frames(const std::string& preset,
                                                                       int seed, int count) {

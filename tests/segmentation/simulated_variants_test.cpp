@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "classifier_model.h"
 #include "color_threshold.h"
+#include "pixel_classifier/classifier_model.h"
 #include "segmenter_training.h"
 #include "simulated_frames.h"
 #include "stage_harness.h"

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "framework/stage_registry.h"
+#include "source_tree.h"
 #include "tilth/calibration.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
@@ -16,7 +17,7 @@
 namespace tilth {
 namespace {
 
-const std::string kCalibration = std::string(TILTH_SOURCE_DIR) + "/calib/paper_rig.calib.json";
+const std::string kCalibration = testing::paper_rig_path().string();
 
 struct SceneFrame {
   RawTofFrame raw;

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "in_process_graph.h"
-#include "mcap_reader.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/recording_layout.h"
 #include "output_path.h"
-#include "recording_layout.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 

@@ -13,7 +13,7 @@
 #include "conversion.h"
 #include "data_loss_report.h"
 #include "framework/diagnostics.h"
-#include "mcap_recording.h"
+#include "mcap/mcap_recording.h"
 #include "output_path.h"
 #include "stop_signals.h"
 #include "tilth/error.h"

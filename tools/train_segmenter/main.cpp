@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "classifier_model.h"
 #include "command_line.h"
 #include "commands.h"
 #include "framework/graph_session.h"
+#include "pixel_classifier/classifier_model.h"
 #include "segmenter_training.h"
 #include "tilth/error.h"
 

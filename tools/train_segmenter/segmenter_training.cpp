@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <random>
 
-#include "classifier_model.h"
-#include "pixel_features.h"
+#include "pixel_classifier/classifier_model.h"
+#include "pixel_classifier/pixel_features.h"
 #include "tilth/error.h"
 #include "tilth/messages/residue_mask.h"
 

@@ -2,7 +2,7 @@
 // each field aligned to its own size counted from the end of the header; a string is a
 // uint32 length that includes a terminating NUL, then the bytes and the NUL; uint8[] is a
 // uint32 count, then the bytes.
-#include "raw_image.h"
+#include "mcap/raw_image.h"
 
 #include <bit>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "mcap_writer.h"
+#include "mcap/mcap_writer.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -9,9 +9,9 @@
 #include <cstring>
 #include <utility>
 
-#include "compression.h"
-#include "crc32.h"
-#include "record_codec.h"
+#include "mcap/compression.h"
+#include "mcap/crc32.h"
+#include "mcap/record_codec.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {

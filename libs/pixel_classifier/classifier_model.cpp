@@ -1,10 +1,10 @@
-#include "classifier_model.h"
+#include "pixel_classifier/classifier_model.h"
 
 #include <set>
 
 #include <opencv2/core/persistence.hpp>
 
-#include "pixel_features.h"
+#include "pixel_classifier/pixel_features.h"
 #include "tilth/error.h"
 
 namespace tilth::segmentation {

@@ -1,4 +1,4 @@
-#include "mcap_recording.h"
+#include "mcap/mcap_recording.h"
 
 #include <algorithm>
 #include <limits>
@@ -6,8 +6,8 @@
 #include <optional>
 #include <sstream>
 
-#include "mcap_reader.h"
-#include "mcap_writer.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/mcap_writer.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {

@@ -2,7 +2,7 @@
 // is its entropy coding of literals, which level 1 already does in full: levels 2-3 cost
 // 1.2-5x the time for files at most 2 % smaller, negative levels skip it (no gain at
 // all), and LZ4 finds nothing to gain (docs/mcap.md, bench/mcap).
-#include "compression.h"
+#include "mcap/compression.h"
 
 #include <lz4frame.h>
 #include <zstd.h>
@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <memory>
 
-#include "mcap_format.h"
+#include "mcap/mcap_format.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {

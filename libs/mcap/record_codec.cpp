@@ -1,9 +1,9 @@
-#include "record_codec.h"
+#include "mcap/record_codec.h"
 
 #include <bit>
 #include <cstring>
 
-#include "crc32.h"
+#include "mcap/crc32.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {

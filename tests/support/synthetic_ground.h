@@ -8,9 +8,9 @@
 #include <numbers>
 #include <vector>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
+#include "camera_geometry/lens_model.h"
 #include "tilth/calibration.h"
 
 namespace tilth::testing {
@@ -39,12 +39,11 @@ inline double plane_distance_at(const GroundScene& scene, double x_mm, double y_
 // `scene` on `camera`'s pixel grid; `outliers`, when given, is 255 where an outlier is.
 inline cv::Mat render(const GroundScene& scene, const DepthCameraCalibration& camera,
                       cv::Mat* outliers = nullptr) {
-  std::vector<cv::Point2f> pixels;
+  std::vector<cv::Point2d> pixels;
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) pixels.emplace_back(u, v);
   }
-  std::vector<cv::Point2f> rays;
-  cv::undistortPoints(pixels, rays, camera.camera_matrix(), camera.distortion);
+  const std::vector<cv::Point2d> rays = lens::undistort(camera, pixels, "the test camera");
 
   const double slope_x = std::tan(radians(scene.tilt_y_deg));
   const double slope_y = std::tan(radians(scene.tilt_x_deg));
@@ -54,7 +53,7 @@ inline cv::Mat render(const GroundScene& scene, const DepthCameraCalibration& ca
   cv::Mat outlier_mask(camera.height, camera.width, CV_8UC1, cv::Scalar(0));
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) {
-      const cv::Point2f ray = rays[static_cast<std::size_t>(v * camera.width + u)];
+      const cv::Point2d ray = rays[static_cast<std::size_t>(v * camera.width + u)];
       // Z = Z0 + sx X + sy Y with X = x' Z, Y = y' Z.
       const double z = axis_depth / (1.0 - slope_x * ray.x - slope_y * ray.y);
       double mm = z - camera.z_offset_mm + random.gaussian(scene.noise_mm);

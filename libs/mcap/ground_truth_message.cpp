@@ -1,4 +1,4 @@
-#include "ground_truth_message.h"
+#include "mcap/ground_truth_message.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-#include "lens_model.h"
+#include "camera_geometry/lens_model.h"
 
 #include <cmath>
 #include <sstream>

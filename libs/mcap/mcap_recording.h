@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "mcap_reader.h"
+#include "mcap/mcap_reader.h"
 
 namespace tilth::mcap {
 

@@ -1,6 +1,6 @@
 // Slicing-by-8: eight tables let the loop consume eight bytes per step, fast enough to
 // check several hundred megabytes per second of chunk data.
-#include "crc32.h"
+#include "mcap/crc32.h"
 
 #include <array>
 #include <bit>

@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "mcap_format.h"
+#include "mcap/mcap_format.h"
 
 namespace tilth::mcap {
 

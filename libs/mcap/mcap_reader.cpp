@@ -1,10 +1,10 @@
-#include "mcap_reader.h"
+#include "mcap/mcap_reader.h"
 
 #include <algorithm>
 
-#include "compression.h"
-#include "crc32.h"
-#include "record_codec.h"
+#include "mcap/compression.h"
+#include "mcap/crc32.h"
+#include "mcap/record_codec.h"
 #include "tilth/error.h"
 
 namespace tilth::mcap {

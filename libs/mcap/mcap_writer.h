@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "mcap_format.h"
+#include "mcap/mcap_format.h"
 
 namespace tilth::mcap {
 

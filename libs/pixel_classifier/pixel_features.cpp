@@ -1,4 +1,4 @@
-#include "pixel_features.h"
+#include "pixel_classifier/pixel_features.h"
 
 #include <algorithm>
 

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "framework/graph_loader.h"
+#include "source_tree.h"
 #include "tilth/plugin.h"
 
 namespace tilth::testing {
@@ -54,9 +55,7 @@ std::string frame_file(const std::string& folder, std::uint64_t index) {
   return folder + "/" + name;
 }
 
-fs::path shipped_calibration_file() {
-  return fs::path(TILTH_SOURCE_DIR) / "calib" / "paper_rig.calib.json";
-}
+fs::path shipped_calibration_file() { return paper_rig_path(); }
 
 nlohmann::json small_calibration() {
   nlohmann::json calibration = nlohmann::json::parse(read_text(shipped_calibration_file()));
