@@ -3,10 +3,11 @@
 //     "include": [{"file": "chain.json", "as": "chain", "variables": {...}}],
 //     "nodes": {"name": {"type": "family.stage", "params": {...}}},
 //     "edges": [["a.out", "b.in"], {"from": "a.out", "to": "b.in"}],
+//     "inputs": {"raw": "a.in"}, "outputs": {"distance": "b.out"},
 //     "runtime": {"max_in_flight": 4, "when_full": "block", "on_error": "skip"} }
 // A node of the including file with the name of an included node replaces it when it
 // names a type, overrides only the parameters it lists otherwise, and removes it (with
-// its edges) when it is null.
+// its edges, inputs and outputs) when it is null.
 #include "framework/graph_loader.h"
 
 #include <algorithm>
@@ -26,7 +27,8 @@ namespace {
 using json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables", "include",
+const std::vector<std::string> kTopLevelKeys = {"description", "plugins", "variables",
+                                                "include",     "inputs",  "outputs",
                                                 "nodes",       "edges",   "runtime"};
 const std::vector<std::string> kNodeKeys = {"type", "params", "description"};
 const std::vector<std::string> kIncludeKeys = {"file", "as", "variables"};
@@ -88,6 +90,8 @@ class Loader {
     load_includes(document, root, dir, prefix, variables);
     load_nodes(document, root, dir, prefix, variables);
     load_edges(document, root, prefix);
+    load_boundary(document, root, prefix, "inputs", graph_.inputs);
+    load_boundary(document, root, prefix, "outputs", graph_.outputs);
     load_runtime(document, root);
     chain_.pop_back();
   }
@@ -352,7 +356,8 @@ class Loader {
     }
   }
 
-  // An included node and every edge to or from it leave the graph.
+  // An included node, every edge to or from it and the included file's inputs and outputs
+  // on it leave the graph.
   void remove_node(const std::string& name, const Location& where) {
     const auto found = node_index_.find(name);
     if (found == node_index_.end()) {
@@ -371,6 +376,9 @@ class Loader {
     };
     std::erase_if(graph_.edges,
                   [&](const EdgeSpec& edge) { return touches(edge.from) || touches(edge.to); });
+    const auto on_it = [&](const BoundaryPort& port) { return touches(port.endpoint); };
+    std::erase_if(graph_.inputs, on_it);
+    std::erase_if(graph_.outputs, on_it);
   }
 
   void load_edges(const json& document, const Location& root, const std::string& prefix) {
@@ -400,6 +408,25 @@ class Loader {
       }
       graph_.edges.push_back(
           {prefix + from.get<std::string>(), prefix + to.get<std::string>(), where});
+    }
+  }
+
+  // "inputs" / "outputs": {"name": "node.port", ...}.
+  void load_boundary(const json& document, const Location& root, const std::string& prefix,
+                     const std::string& key, std::vector<BoundaryPort>& ports) {
+    if (!document.contains(key)) return;
+    const Location where = root.child(key);
+    if (!document[key].is_object()) {
+      diagnostics_.add(where, "expected an object of name: \"node.port\"");
+      return;
+    }
+    for (const auto& [name, endpoint] : document[key].items()) {
+      if (!endpoint.is_string()) {
+        diagnostics_.add(where.child(name), "expected \"node.port\", got " + endpoint.dump());
+        continue;
+      }
+      ports.push_back(
+          {name, prefix + endpoint.get<std::string>(), where.child(name), chain_.size() == 1});
     }
   }
 

@@ -38,6 +38,16 @@ struct EdgeSpec {
   Location where;
 };
 
+// A port on a graph file's boundary, declared in its "inputs" or "outputs": what a graph
+// that includes the file feeds or reads. A file whose inputs are not fed is a fragment:
+// it validates on its own but cannot run.
+struct BoundaryPort {
+  std::string name;
+  std::string endpoint;  // "node.port", qualified as the node
+  Location where;
+  bool top_level;  // declared by the graph file itself, not by an include
+};
+
 enum class FullPolicy { kBlock, kDropOldest };
 enum class ErrorPolicy { kSkipFrame, kStop };
 
@@ -53,6 +63,8 @@ struct GraphSpec {
   std::vector<std::filesystem::path> plugins;  // extra plugin libraries named by the graph
   std::vector<NodeSpec> nodes;                 // in the order written
   std::vector<EdgeSpec> edges;
+  std::vector<BoundaryPort> inputs;
+  std::vector<BoundaryPort> outputs;
   RuntimeOptions runtime;
 };
 

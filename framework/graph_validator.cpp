@@ -46,9 +46,12 @@ class Validator {
   ValidatedGraph run() {
     resolve_nodes();
     resolve_edges();
+    resolve_boundary();
     check_inputs_connected();
     check_synchronized_sources();
-    if (!has_source_) diagnostics_.add({graph_.file.string(), ""}, "the graph has no source stage");
+    if (!has_source_ && open_inputs_.empty()) {
+      diagnostics_.add({graph_.file.string(), ""}, "the graph has no source stage");
+    }
     const std::vector<std::size_t> order = topological_order();
     diagnostics_.throw_if_any();
     return assemble(order);
@@ -170,14 +173,31 @@ class Validator {
     }
   }
 
+  // Each declared input and output names a port of the right direction; the graph file's
+  // own inputs that nothing feeds are open: fed by a graph that includes the file.
+  void resolve_boundary() {
+    for (const BoundaryPort& port : graph_.inputs) {
+      const auto endpoint = resolve_endpoint(port.endpoint, port.where, false);
+      if (!endpoint || !port.top_level || inputs_[endpoint->node][endpoint->port]) continue;
+      open_inputs_.insert({endpoint->node, endpoint->port});
+      open_input_names_.push_back(port.name + " (" + port.endpoint + ")");
+    }
+    for (const BoundaryPort& port : graph_.outputs) {
+      if (resolve_endpoint(port.endpoint, port.where, true) && port.top_level) {
+        output_names_.push_back(port.name + " (" + port.endpoint + ")");
+      }
+    }
+  }
+
   void check_inputs_connected() {
     for (std::size_t i = 0; i < nodes_.size(); ++i) {
       if (nodes_[i].stage == nullptr) continue;
       const auto& ports = nodes_[i].stage->descriptor.inputs;
       bool any_connected = false;
       for (std::size_t p = 0; p < ports.size(); ++p) {
-        any_connected = any_connected || inputs_[i][p];
-        if (!inputs_[i][p] && ports[p].required) {
+        const bool fed = inputs_[i][p] || open_inputs_.contains({i, p});
+        any_connected = any_connected || fed;
+        if (!fed && ports[p].required) {
           diagnostics_.add(nodes_[i].where, "input '" + ports[p].name + "' (" + ports[p].type +
                                                 ") is not connected");
         }
@@ -292,7 +312,8 @@ class Validator {
   ValidatedGraph assemble(const std::vector<std::size_t>& order) {
     std::vector<std::size_t> position(nodes_.size());
     for (std::size_t i = 0; i < order.size(); ++i) position[order[i]] = i;
-    ValidatedGraph result{graph_.file, graph_.description, {}, graph_.runtime};
+    ValidatedGraph result{graph_.file,    graph_.description, {},
+                          graph_.runtime, open_input_names_,  output_names_};
     for (std::size_t original : order) {
       ResolvedNode node = std::move(nodes_[original]);
       for (const auto& feed : inputs_[original]) {
@@ -323,7 +344,10 @@ class Validator {
   std::vector<ResolvedNode> nodes_;
   // name -> index in nodes_; the loader gives every node its own name.
   std::unordered_map<std::string, std::size_t> node_index_;
-  std::vector<std::vector<std::optional<Feed>>> inputs_;  // per node, per input port
+  std::vector<std::vector<std::optional<Feed>>> inputs_;       // per node, per input port
+  std::set<std::pair<std::size_t, std::size_t>> open_inputs_;  // (node, input port)
+  std::vector<std::string> open_input_names_;
+  std::vector<std::string> output_names_;
   bool has_source_ = false;
 };
 

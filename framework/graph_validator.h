@@ -32,6 +32,10 @@ struct ValidatedGraph {
   std::string description;
   std::vector<ResolvedNode> nodes;  // in topological order
   RuntimeOptions runtime;
+  // The graph file's declared inputs that nothing in it feeds, as "name (node.port)": a
+  // fragment, which a graph including it feeds; it cannot run on its own.
+  std::vector<std::string> open_inputs;
+  std::vector<std::string> outputs;  // its declared outputs, as "name (node.port)"
 };
 
 // Throws GraphError with every problem found.

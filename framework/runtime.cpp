@@ -13,6 +13,7 @@
 #include "framework/frame_admission.h"
 #include "framework/keyed_join.h"
 #include "framework/latency_histogram.h"
+#include "framework/nearest_names.h"
 #include "framework/sequence_reorder.h"
 #include "framework/thread_sanitizer.h"
 #include "tilth/log.h"
@@ -110,6 +111,11 @@ class Runtime::Impl {
  public:
   Impl(ValidatedGraph graph, const StageRegistry& registry, RunLimits limits)
       : graph_(std::move(graph)), limits_(limits) {
+    if (!graph_.open_inputs.empty()) {
+      throw Error(graph_.file.string() + ": a fragment: nothing feeds its inputs " +
+                  quoted_list(graph_.open_inputs) +
+                  "; run a graph that includes it and feeds them (docs/graph-format.md)");
+    }
     make_stages(registry);
     wire();
     admission_ = std::make_unique<FrameAdmission>(

@@ -7,6 +7,7 @@
 #include <boost/dll/shared_library.hpp>
 
 #include "framework/nearest_names.h"
+#include "tilth/log.h"
 #include "tilth/plugin.h"
 
 namespace tilth {
@@ -70,6 +71,34 @@ std::vector<fs::path> plugin_search_path(const fs::path& graph_dir) {
   return dirs;
 }
 
+namespace {
+
+std::string text_of(const char* stamp_field) { return stamp_field ? stamp_field : "?"; }
+
+// Refuses a plugin built on another standard library, OpenCV or nlohmann-json; notes
+// another compiler.
+void check_build(const std::string& name, const BuildStamp& plugin) {
+  const std::pair<const char*, const char*> libraries[] = {
+      {plugin.standard_library, kThisBuild.standard_library},
+      {plugin.opencv, kThisBuild.opencv},
+      {plugin.json, kThisBuild.json}};
+  for (const auto& [theirs, ours] : libraries) {
+    if (text_of(theirs) != ours) {
+      throw Error(name + ": built with " + describe(plugin) + ", this runtime with " +
+                  describe(kThisBuild) +
+                  "; rebuild the plugin against this SDK and the same libraries (the plugin "
+                  "interface passes their types)");
+    }
+  }
+  if (text_of(plugin.compiler) != kThisBuild.compiler) {
+    Logger("plugins").warning(name + ": built with " + text_of(plugin.compiler) +
+                              ", this runtime with " + kThisBuild.compiler +
+                              "; loaded, as both use the same libraries");
+  }
+}
+
+}  // namespace
+
 void StageRegistry::load(const fs::path& file) {
   const std::string name = file.string();
   if (!fs::exists(file)) throw Error(name + ": no such plugin library");
@@ -92,6 +121,7 @@ void StageRegistry::load(const fs::path& file) {
     throw Error(name + ": malformed plugin descriptor (size " + std::to_string(plugin->size) +
                 ", expected " + std::to_string(sizeof(PluginDescriptor)) + ")");
   }
+  check_build(name, plugin->build);
   // Check the whole plugin before registering any of it.
   for (const auto& descriptor : *plugin->stages) {
     if (const std::string problem = check_descriptor(descriptor); !problem.empty()) {

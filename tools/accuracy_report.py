@@ -90,7 +90,7 @@ def main():
   figures above are therefore the chain's own error, not a field accuracy.
 - `wet_straw` is the colour-threshold method's known failure: dark, wet straw is
   classified as soil and its tops pull the distance short. Segmentation variants that
-  use depth address it (see docs/segmentation.md).
+  use depth address it (see docs/segmentation-variants.md).
 - `covered` is reported invalid on every frame, never as a guess.""")
     if args.check_max_error_mm is not None:
         for problem in problems:

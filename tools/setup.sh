@@ -14,7 +14,7 @@ packages=(
   # machine outputs and their real peers in tests
   libmodbus-dev mbpoll python3-pymodbus python3-serial python3-serial-asyncio
   # recordings
-  libzstd-dev liblz4-dev nodejs
+  libzstd-dev liblz4-dev zlib1g-dev nodejs
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # the fuzz targets: clang with libFuzzer and its sanitizer runtimes

@@ -1,5 +1,5 @@
 // CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320) as MCAP uses it for chunks,
-// attachments, the data section and the summary; incremental.
+// attachments, the data section and the summary; incremental. zlib's.
 #pragma once
 
 #include <cstdint>

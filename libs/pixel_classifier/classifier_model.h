@@ -1,6 +1,6 @@
 // The model file of segmentation.pixel_classifier, written by tilth train-segmenter: a
 // random forest over the pixel features, stored with the format version, the features
-// and colour cells it was trained on, and how it was trained (docs/segmentation.md).
+// and colour cells it was trained on, and how it was trained (docs/segmentation-variants.md).
 #pragma once
 
 #include <cstdint>

@@ -31,7 +31,7 @@ namespace {
 constexpr float kMinLightness = 10.0f;
 // Centres closer than this (in 100 * a*/L*, b*/L*) are one material: straw and soil lie
 // about 25 apart, a frame of one material splits into halves about 5 apart
-// (docs/segmentation.md).
+// (docs/segmentation-variants.md).
 constexpr double kMinSeparation = 12.0;
 // For one material: straw lies at hue angles of 85-95 deg, soils at 50-72 deg; residue is
 // the half-plane of hue angles from this one to 180 deg more.

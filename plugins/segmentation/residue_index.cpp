@@ -18,7 +18,7 @@ constexpr int kBins = 256;
 
 // Histogram range (values outside are counted in the end bins), which side residue is
 // on, the absolute boundary for frames of one material, and the least gap between
-// Otsu's class means that still counts as two materials. docs/segmentation.md derives
+// Otsu's class means that still counts as two materials. docs/segmentation-variants.md derives
 // them from the reference colours and the simulator.
 struct IndexInfo {
   const char* name;

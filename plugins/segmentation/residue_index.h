@@ -1,6 +1,6 @@
 // Colour indices that tell residue from soil, each with its automatic threshold (Otsu's,
 // on the frame's own histogram) and, for frames that show one material only, an absolute
-// boundary. docs/segmentation.md explains the indices and the constants.
+// boundary. docs/segmentation-variants.md explains the indices and the constants.
 #pragma once
 
 #include <string>

@@ -60,6 +60,18 @@ class Validation(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn("valid, 2 nodes", result.stdout)
 
+    def test_a_sub_graph_validates_as_a_fragment_and_does_not_run(self):
+        chain = os.path.join(SOURCE, "graphs", "measurement-chain.json")
+        result = tilth("validate", chain)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("valid, 4 nodes; a fragment: a graph that includes it feeds its inputs "
+                      "'raw (project.raw)', 'color (register.color)'; outputs "
+                      "'distance (estimate.distance)'", result.stdout)
+        result = tilth("run", chain)
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("a fragment: nothing feeds its inputs 'raw (project.raw)', "
+                      "'color (register.color)'", result.stderr)
+
     def test_invalid_graph_reports_every_problem(self):
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "g.json")

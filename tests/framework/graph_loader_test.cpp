@@ -107,13 +107,15 @@ TEST(GraphLoader, NodeWithTypeReplacesIncludedNode) {
 }
 
 // An override file swaps the cameras of a machine graph for a simulator: null removes
-// an included node and its edges; the new node is wired in its place.
+// an included node, its edges and the inputs and outputs on it; the new node is wired in
+// its place.
 TEST(GraphLoader, NullRemovesAnIncludedNodeWithItsEdges) {
   TempDir dir;
   dir.write("machine.json", R"({
     "nodes": {"cam": {"type": "test.camera"}, "pair": {"type": "test.pair"},
               "chain": {"type": "test.chain"}},
-    "edges": [["cam.image", "pair.image"], ["pair.image", "chain.in"]]
+    "edges": [["cam.image", "pair.image"], ["pair.image", "chain.in"]],
+    "inputs": {"frames": "chain.in"}, "outputs": {"paired": "pair.image", "result": "chain.out"}
   })");
   const auto file = dir.write("g.json", R"({
     "include": ["machine.json"],
@@ -126,6 +128,11 @@ TEST(GraphLoader, NullRemovesAnIncludedNodeWithItsEdges) {
   EXPECT_EQ(graph.nodes[1].name, "sim");
   ASSERT_EQ(graph.edges.size(), 1u);
   EXPECT_EQ(graph.edges[0].from, "sim.raw");
+  ASSERT_EQ(graph.inputs.size(), 1u);  // the removed node's output left with it
+  EXPECT_EQ(graph.inputs[0].endpoint, "chain.in");
+  EXPECT_FALSE(graph.inputs[0].top_level);
+  ASSERT_EQ(graph.outputs.size(), 1u);
+  EXPECT_EQ(graph.outputs[0].name, "result");
 
   const auto wrong =
       dir.write("h.json", R"({"include": ["machine.json"], "nodes": {"cma": null}})");
@@ -209,8 +216,8 @@ TEST(GraphLoader, ReportsEveryProblemAtOnce) {
   EXPECT_EQ(load_error(file),
             f +
                 ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
-                "of 'description', 'plugins', 'variables', 'include', 'nodes', 'edges', "
-                "'runtime')\n" +
+                "of 'description', 'plugins', 'variables', 'include', 'inputs', 'outputs', 'nodes', "
+                "'edges', 'runtime')\n" +
                 f + ":/nodes/a/params/count: unknown variable 'missing' (defined: none)\n" + f +
                 ":/nodes/b: node 'b' has no \"type\" and overrides no included node; did you mean "
                 "'a'?\n" +

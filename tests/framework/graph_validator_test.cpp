@@ -5,6 +5,7 @@
 
 #include "framework/diagnostics.h"
 #include "framework/graph_loader.h"
+#include "framework/runtime.h"
 #include "temp_dir.h"
 #include "test_stages.h"
 #include "tilth/messages/depth_image.h"
@@ -165,6 +166,69 @@ TEST_F(GraphValidatorTest, CommandLineValuesTakeTheParameterType) {
   EXPECT_EQ(
       errors(R"({"nodes": {"src": {"type": "test.counter"}}})", {{{"src.count", "many"}}, {}}),
       "command line:--set src.count: parameter 'count': expected an integer >= 0, got \"many\"");
+}
+
+// A sub-graph file: two inputs and an output on its boundary, one more input fed inside.
+constexpr const char* kFragment = R"({
+  "inputs": {"left": "sum.a", "right": "sum.b"},
+  "outputs": {"total": "sum.sum"},
+  "nodes": {"sum": {"type": "test.add"}, "out": {"type": "test.record"}},
+  "edges": [["sum.sum", "out.in"]]
+})";
+
+TEST_F(GraphValidatorTest, AFragmentValidatesOnItsOwnWithItsInputsOpen) {
+  dir_.write("g.json", kFragment);
+  const ValidatedGraph graph = validate_graph(load_graph(file_), registry_);
+  EXPECT_EQ(graph.open_inputs, (std::vector<std::string>{"left (sum.a)", "right (sum.b)"}));
+  EXPECT_EQ(graph.outputs, (std::vector<std::string>{"total (sum.sum)"}));
+  EXPECT_EQ(graph.nodes.size(), 2u);
+}
+
+TEST_F(GraphValidatorTest, AFragmentStillReportsItsOtherProblems) {
+  EXPECT_EQ(errors(R"({"inputs": {"left": "sum.a"},
+                       "nodes": {"sum": {"type": "test.add"}, "out": {"type": "test.record"}},
+                       "edges": [["sum.sum", "out.in"]]})"),
+            at("/nodes/sum") + ": input 'b' (test.Count) is not connected");
+  EXPECT_EQ(errors(R"({"inputs": {"left": "sum.sum", "right": "sum.b", "x": "nothing.in"},
+                       "outputs": {"total": "sum.a"},
+                       "nodes": {"sum": {"type": "test.add"}, "out": {"type": "test.record"}},
+                       "edges": [["sum.sum", "out.in"]]})"),
+            at("/inputs/left") +
+                ": node 'sum' (test.add) has no input port 'sum'; its inputs: 'a', 'b'\n" +
+                at("/inputs/x") + ": no node named 'nothing'\n" + at("/outputs/total") +
+                ": node 'sum' (test.add) has no output port 'a'; its outputs: 'sum'\n" +
+                at("/nodes/sum") + ": input 'a' (test.Count) is not connected");
+  EXPECT_EQ(errors(R"({"inputs": ["sum.a"], "outputs": {"total": 3},
+                       "nodes": {"src": {"type": "test.counter"}}})"),
+            at("/inputs") + ": expected an object of name: \"node.port\"\n" + at("/outputs/total") +
+                ": expected \"node.port\", got 3");
+}
+
+TEST_F(GraphValidatorTest, AnIncludedFragmentsInputsMustBeFed) {
+  dir_.write("fragment.json", kFragment);
+  const std::string include = R"("include": [{"file": "fragment.json", "as": "f"}],
+    "nodes": {"src": {"type": "test.counter"}},)";
+  EXPECT_EQ(errors("{" + include + R"("edges": [["src.out", "f/sum.a"]]})"),
+            (dir_.path() / "fragment.json").string() +
+                ":/nodes/sum: input 'b' (test.Count) is not connected");
+  dir_.write("g.json",
+             "{" + include + R"("edges": [["src.out", "f/sum.a"], ["src.out", "f/sum.b"]]})");
+  const ValidatedGraph graph = validate_graph(load_graph(file_), registry_);
+  EXPECT_TRUE(graph.open_inputs.empty());
+  EXPECT_TRUE(graph.outputs.empty());  // the included file's, not this graph's
+}
+
+TEST_F(GraphValidatorTest, AFragmentCannotRun) {
+  dir_.write("g.json", kFragment);
+  try {
+    Runtime runtime(validate_graph(load_graph(file_), registry_), registry_);
+    FAIL() << "a fragment ran";
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              file_.string() +
+                  ": a fragment: nothing feeds its inputs 'left (sum.a)', 'right (sum.b)'; run a "
+                  "graph that includes it and feeds them (docs/graph-format.md)");
+  }
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 
 #include "framework/stage_registry.h"
 #include "tilth/abi.h"
+#include "tilth/build_stamp.h"
+#include "tilth/log.h"
 #include "tilth/messages/raw_tof_frame.h"
 
 namespace tilth {
@@ -71,6 +73,35 @@ TEST(PluginLoading, AbiMismatch) {
             plugin("wrong_abi").string() + ": built for Tilth plugin ABI " +
                 std::to_string(kAbiVersion + 1) + ", this runtime has ABI " +
                 std::to_string(kAbiVersion) + "; rebuild the plugin against this SDK");
+}
+
+TEST(PluginLoading, RefusesAPluginBuiltOnOtherLibraries) {
+  StageRegistry registry;
+  const BuildStamp theirs{kThisBuild.compiler, kThisBuild.standard_library, "3.4", kThisBuild.json};
+  EXPECT_EQ(load_error(registry, plugin("other_opencv")),
+            plugin("other_opencv").string() + ": built with " + describe(theirs) +
+                ", this runtime with " + describe(kThisBuild) +
+                "; rebuild the plugin against this SDK and the same libraries (the plugin "
+                "interface passes their types)");
+  EXPECT_NE(describe(theirs).find("OpenCV 3.4"), std::string::npos);
+  EXPECT_TRUE(registry.entries().empty());
+}
+
+TEST(PluginLoading, LoadsAPluginOfAnotherCompilerOnTheSameLibrariesWithAWarning) {
+  std::vector<std::string> warnings;
+  const LogHandler previous =
+      set_log_handler([&](LogLevel level, std::string_view where, std::string_view message) {
+        if (level == LogLevel::kWarning)
+          warnings.push_back(std::string(where) + ": " + std::string(message));
+      });
+  StageRegistry registry;
+  const std::string outcome = load_error(registry, plugin("other_compiler"));
+  set_log_handler(previous);
+  EXPECT_EQ(outcome, "loaded");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "plugins: " + plugin("other_compiler").string() +
+                             ": built with Some Compiler 99, this runtime with " +
+                             kThisBuild.compiler + "; loaded, as both use the same libraries");
 }
 
 TEST(PluginLoading, DuplicateStageType) {

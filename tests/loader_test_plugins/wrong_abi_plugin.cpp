@@ -3,7 +3,8 @@
 
 extern "C" __attribute__((visibility("default"))) const tilth::PluginDescriptor*
 tilth_plugin_descriptor() {
-  static const tilth::PluginDescriptor descriptor{
-      tilth::kAbiVersion + 1, sizeof(tilth::PluginDescriptor), "future", nullptr};
+  static const tilth::PluginDescriptor descriptor{tilth::kAbiVersion + 1,
+                                                  sizeof(tilth::PluginDescriptor), "future",
+                                                  nullptr, tilth::kThisBuild};
   return &descriptor;
 }

@@ -2,7 +2,7 @@
 // registered in process), against the simulator's ground truth: mask IoU, and the ground
 // distance the paper's estimator would report from the soil depth (the median in the
 // middle half of the image). The thresholds are the measured figures with a margin; the
-// comments give the measurements (docs/segmentation.md has the full table).
+// comments give the measurements (docs/segmentation-variants.md has the full table).
 #include <algorithm>
 #include <cmath>
 #include <iostream>

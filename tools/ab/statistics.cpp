@@ -3,48 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include <boost/math/distributions/students_t.hpp>
+
 #include "tilth/error.h"
 
 namespace tilth::ab {
 namespace {
-
-// Continued fraction of the incomplete beta function (modified Lentz's method).
-double beta_continued_fraction(double a, double b, double x) {
-  constexpr double kTiny = 1e-300;
-  double c = 1.0;
-  double d = 1.0 - (a + b) * x / (a + 1.0);
-  if (std::abs(d) < kTiny) d = kTiny;
-  d = 1.0 / d;
-  double result = d;
-  for (int m = 1; m <= 1000; ++m) {
-    const double m2 = 2.0 * m;
-    for (const double coefficient : {m * (b - m) * x / ((a + m2 - 1.0) * (a + m2)),
-                                     -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1.0))}) {
-      d = 1.0 + coefficient * d;
-      if (std::abs(d) < kTiny) d = kTiny;
-      c = 1.0 + coefficient / c;
-      if (std::abs(c) < kTiny) c = kTiny;
-      d = 1.0 / d;
-      result *= d * c;
-    }
-    if (std::abs(d * c - 1.0) < 1e-15) break;
-  }
-  return result;
-}
-
-double regularized_incomplete_beta(double a, double b, double x) {
-  if (x <= 0.0) return 0.0;
-  if (x >= 1.0) return 1.0;
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
-                                a * std::log(x) + b * std::log1p(-x));
-  if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_continued_fraction(a, b, x) / a;
-  return 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b;
-}
-
-double student_t_cdf(double t, double dof) {
-  const double tail = 0.5 * regularized_incomplete_beta(dof / 2.0, 0.5, dof / (dof + t * t));
-  return t >= 0.0 ? 1.0 - tail : tail;
-}
 
 std::optional<double> ratio(std::int64_t numerator, std::int64_t denominator) {
   if (denominator == 0) return std::nullopt;
@@ -85,14 +49,7 @@ double student_t_quantile(double p, double dof) {
     throw Error("student_t_quantile: expected 0 < p < 1 and dof > 0, got p " + std::to_string(p) +
                 ", dof " + std::to_string(dof));
   }
-  if (p < 0.5) return -student_t_quantile(1.0 - p, dof);
-  double low = 0.0, high = 1.0;
-  while (student_t_cdf(high, dof) < p) high *= 2.0;
-  for (int i = 0; i < 200 && high - low > 1e-13 * high; ++i) {
-    const double middle = 0.5 * (low + high);
-    (student_t_cdf(middle, dof) < p ? low : high) = middle;
-  }
-  return 0.5 * (low + high);
+  return boost::math::quantile(boost::math::students_t(dof), p);
 }
 
 MaskCounts& MaskCounts::operator+=(const MaskCounts& other) {

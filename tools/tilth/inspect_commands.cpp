@@ -47,7 +47,14 @@ int validate_command(int argc, char** argv) {
   }
   try {
     const auto session = open_graph(line.positional()[0], graph_overrides(line));
-    std::cout << line.positional()[0] << ": valid, " << session.graph.nodes.size() << " nodes\n";
+    const ValidatedGraph& graph = session.graph;
+    std::cout << line.positional()[0] << ": valid, " << graph.nodes.size() << " nodes";
+    if (!graph.open_inputs.empty()) {
+      std::cout << "; a fragment: a graph that includes it feeds its inputs "
+                << quoted_list(graph.open_inputs);
+    }
+    if (!graph.outputs.empty()) std::cout << "; outputs " << quoted_list(graph.outputs);
+    std::cout << "\n";
     return kExitOk;
   } catch (const GraphError& error) {
     std::cerr << error.what() << "\n";

@@ -6,6 +6,6 @@
 
 namespace tilth {
 
-inline constexpr std::uint32_t kAbiVersion = 3;
+inline constexpr std::uint32_t kAbiVersion = 4;
 
 }  // namespace tilth

@@ -8,17 +8,19 @@
 #include <vector>
 
 #include "tilth/abi.h"
+#include "tilth/build_stamp.h"
 #include "tilth/stage_descriptor.h"
 
 namespace tilth {
 
 // The one symbol a plugin exports (`tilth_plugin_descriptor`) returns this. The runtime
-// checks abi_version and size before reading any other field.
+// checks abi_version and size before reading any other field, then the build stamp.
 struct PluginDescriptor {
   std::uint32_t abi_version;
   std::uint32_t size;
   const char* name;
   const std::vector<StageDescriptor>* stages;
+  BuildStamp build;
 };
 
 namespace detail {
@@ -45,7 +47,7 @@ struct StageRegistration {
   tilth_plugin_descriptor() {                                                        \
     static const ::tilth::PluginDescriptor descriptor{                               \
         ::tilth::kAbiVersion, sizeof(::tilth::PluginDescriptor), plugin_name,        \
-        &::tilth::detail::plugin_stages()};                                          \
+        &::tilth::detail::plugin_stages(), ::tilth::kThisBuild};                     \
     return &descriptor;                                                              \
   }
 
