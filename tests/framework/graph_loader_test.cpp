@@ -213,19 +213,19 @@ TEST(GraphLoader, ReportsEveryProblemAtOnce) {
     "runtime": {"when_full": "drop_newest"}
   })");
   const std::string f = file.string();
-  EXPECT_EQ(load_error(file),
-            f +
-                ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
-                "of 'description', 'plugins', 'variables', 'include', 'inputs', 'outputs', 'nodes', "
-                "'edges', 'runtime')\n" +
-                f + ":/nodes/a/params/count: unknown variable 'missing' (defined: none)\n" + f +
-                ":/nodes/b: node 'b' has no \"type\" and overrides no included node; did you mean "
-                "'a'?\n" +
-                f + ":/nodes/c.d: node names must be non-empty, without '.', and not 'runtime'\n" +
-                f +
-                ":/edges/0: expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": "
-                "...}\n" +
-                f + ":/runtime/when_full: expected 'block' or 'drop_oldest', got \"drop_newest\"");
+  EXPECT_EQ(
+      load_error(file),
+      f +
+          ":/nodez: unknown key 'nodez' in graph file; did you mean 'nodes'? (expected one "
+          "of 'description', 'plugins', 'variables', 'include', 'inputs', 'outputs', 'nodes', "
+          "'edges', 'runtime')\n" +
+          f + ":/nodes/a/params/count: unknown variable 'missing' (defined: none)\n" + f +
+          ":/nodes/b: node 'b' has no \"type\" and overrides no included node; did you mean "
+          "'a'?\n" +
+          f + ":/nodes/c.d: node names must be non-empty, without '.', and not 'runtime'\n" + f +
+          ":/edges/0: expected [\"node.port\", \"node.port\"] or {\"from\": ..., \"to\": "
+          "...}\n" +
+          f + ":/runtime/when_full: expected 'block' or 'drop_oldest', got \"drop_newest\"");
 }
 
 TEST(GraphLoader, UnknownOverrideTargetSuggestsNode) {
