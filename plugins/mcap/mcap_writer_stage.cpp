@@ -31,6 +31,7 @@
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/plugin.h"
+#include "tilth/version.h"
 
 namespace tilth::mcap {
 namespace {
@@ -102,7 +103,8 @@ class McapWriterStage final : public Sink {
     writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", calibration_text_}}});
     const fs::path graph = context.params.string("graph_file");
     std::map<std::string, std::string> recording{{"node", context.node},
-                                                 {"log_time", context.params.string("log_time")}};
+                                                 {"log_time", context.params.string("log_time")},
+                                                 {"tilth_version", std::string(version())}};
     if (!graph.empty()) {
       writer_.add_attachment({created, created, graph.filename().string(), "application/json",
                               read_json_text(graph, "graph file")});

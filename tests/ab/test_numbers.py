@@ -8,6 +8,7 @@ import csv
 import json
 import math
 import os
+import re
 import statistics
 import unittest
 
@@ -223,6 +224,13 @@ class SummaryTest(unittest.TestCase):
             return
         for key, value in expected["mask"].items():
             self.assertTrue(close(reported["mask"][key], value), (where, "mask", key))
+
+    def test_the_report_names_its_format_and_release(self):
+        with open(os.path.join(os.environ["TILTH_SOURCE_DIR"], "CMakeLists.txt")) as f:
+            release = re.search(r"project\(Tilth VERSION ([0-9.]+)", f.read()).group(1)
+        summary = load_summary(REPORT)
+        self.assertEqual(summary["format"], "tilth-ab/1")
+        self.assertEqual(summary["tilth_version"], release)
 
     def test_per_recording_figures(self):
         summary = load_summary(REPORT)

@@ -26,6 +26,23 @@ class HelpAndInspection(unittest.TestCase):
         self.assertEqual(tilth("--help").returncode, 0)
         self.assertEqual(tilth("frobnicate").returncode, 2)
 
+    def test_version_help_command_and_suggestions(self):
+        with open(os.path.join(SOURCE, "CMakeLists.txt")) as f:
+            release = re.search(r"project\(Tilth VERSION ([0-9.]+)", f.read()).group(1)
+        result = tilth("--version")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(result.stdout.splitlines()[0], "tilth " + release)
+        self.assertRegex(result.stdout.splitlines()[1],
+                         r"^built with (GCC|Clang) \d+, .*OpenCV \d+\.\d+, nlohmann-json "
+                         r"\d+\.\d+\.\d+; plugin ABI \d+$")
+        self.assertEqual(tilth("version").stdout, result.stdout)
+        help_ = tilth("help", "validate")
+        self.assertEqual(help_.returncode, 0, help_.stderr)
+        self.assertEqual(help_.stdout, tilth("validate", "--help").stdout)
+        wrong = tilth("valdate", "g.json")
+        self.assertEqual(wrong.returncode, 2)
+        self.assertIn("tilth: unknown command 'valdate'; did you mean 'validate'?", wrong.stderr)
+
     def test_plugins_lists_types_with_ports(self):
         result = tilth("plugins")
         self.assertEqual(result.returncode, 0, result.stderr)

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "tilth/error.h"
+#include "tilth/version.h"
 
 namespace tilth::ab {
 namespace {
@@ -179,6 +180,7 @@ json summary_json(const Comparison& comparison, const Overlays& overlays) {
     disagreements.push_back({{"recording", comparison.recordings[r].name}, {"frames", frames}});
   }
   return {{"format", "tilth-ab/1"},
+          {"tilth_version", std::string(version())},
           {"no_soil_below", comparison.no_soil_below},
           {"variants", variants},
           {"recordings", recordings},

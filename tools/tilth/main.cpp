@@ -2,10 +2,15 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "external_commands.h"
+#include "framework/nearest_names.h"
+#include "tilth/abi.h"
+#include "tilth/build_stamp.h"
 #include "tilth/error.h"
+#include "tilth/version.h"
 
 namespace {
 
@@ -20,8 +25,9 @@ commands:
   plugins          list the stage types of the plugins found, with their ports
   describe TYPE    print a stage type's ports and full parameter schema
   dot GRAPH        print a graph as Graphviz dot
+  help COMMAND     describe a command's options (as 'tilth COMMAND --help')
 
-'tilth COMMAND --help' describes a command's options. Any other COMMAND runs the
+'tilth --version' prints the release and what it was built with. Any other COMMAND runs the
 program tilth-COMMAND found next to tilth or on PATH.
 Plugins are searched next to the graph file, in TILTH_PLUGIN_PATH, and in the build
 and install plugin directories.
@@ -36,14 +42,33 @@ void print_usage() {
   std::cout << "\n";
 }
 
+const std::vector<std::string> kCommands = {"run", "validate", "plugins", "describe", "dot"};
+
+void print_version() {
+  std::cout << "tilth " << tilth::version() << "\nbuilt with " << tilth::describe(tilth::kThisBuild)
+            << "; plugin ABI " << tilth::kAbiVersion << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace tilth::cli;
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
-      std::strcmp(argv[1], "help") == 0) {
+      (std::strcmp(argv[1], "help") == 0 && argc == 2)) {
     print_usage();
     return argc < 2 ? kExitUsage : kExitOk;
+  }
+  if (std::strcmp(argv[1], "--version") == 0 || std::strcmp(argv[1], "version") == 0) {
+    print_version();
+    return kExitOk;
+  }
+  // `tilth help COMMAND` is `tilth COMMAND --help`.
+  std::vector<char*> help_arguments;
+  if (std::strcmp(argv[1], "help") == 0) {
+    static char help_flag[] = "--help";
+    help_arguments = {argv[0], argv[2], help_flag, nullptr};
+    argc = 3;
+    argv = help_arguments.data();
   }
   const std::string command = argv[1];
   try {
@@ -57,6 +82,10 @@ int main(int argc, char** argv) {
     std::cerr << "tilth " << command << ": " << error.what() << "\n";
     return kExitUsage;
   }
-  std::cerr << "tilth: unknown command '" << command << "'\n" << kUsage;
+  std::vector<std::string> known = kCommands;
+  for (const auto& name : external_commands()) known.push_back(name);
+  std::cerr << "tilth: unknown command '" << command << "'" << tilth::did_you_mean(command, known)
+            << "\n\n"
+            << kUsage;
   return kExitUsage;
 }

@@ -138,6 +138,13 @@ test("the calibration is attached and in the metadata", async () => {
   for await (const record of reader.readMetadata({ name: "tilth.calibration" })) metadata.push(record);
   assert.equal(metadata.length, 1);
   assert.equal(metadata[0].metadata.get("json"), calibration);
+  const release = fs
+    .readFileSync(path.join(process.env.TILTH_SOURCE_DIR, "CMakeLists.txt"), "utf8")
+    .match(/project\(Tilth VERSION ([0-9.]+)/)[1];
+  const recording = [];
+  for await (const record of reader.readMetadata({ name: "tilth.recording" })) recording.push(record);
+  assert.equal(recording.length, 1);
+  assert.equal(recording[0].metadata.get("tilth_version"), release);
 });
 
 test("the stream reader reads every record with valid CRCs", () => {
