@@ -15,6 +15,7 @@
 //                           "statistic": "median", "min_soil_fraction": 0.05}}
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <span>
@@ -25,7 +26,6 @@
 #include "estimators.h"
 #include "plausibility.h"
 #include "rank_selection.h"
-#include "soil_kernels.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
@@ -36,6 +36,8 @@
 
 namespace tilth::estimation {
 namespace {
+
+constexpr float kLargest = std::numeric_limits<float>::max();
 
 // Scales the median absolute deviation to the standard deviation of normal data.
 constexpr double kMadToSigma = 1.4826;
@@ -123,20 +125,49 @@ class GroundDistanceEstimator final : public Transform {
     float highest;
   };
 
-  // The region's finite depths, a row at a time with the widest vectors the CPU runs.
-  SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
-                            std::vector<float>& depths) const {
-    // Room for the kernel's whole-vector stores past the last depth. Never shrunk, so no
-    // frame after the first allocates or clears it.
-    const auto slots = static_cast<std::size_t>(roi.area()) + kSlack;
+  // The region's finite depths, in order, and their range, four at a time: soil and
+  // residue come in patches, so four depths are mostly all finite (stored whole) or none,
+  // and a mixed four go one at a time.
+  static SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
+                                   std::vector<float>& depths) {
+    // Never shrunk, so no frame after the first allocates or clears it.
+    const auto slots = static_cast<std::size_t>(roi.area());
     if (depths.size() < slots) depths.resize(slots);
-    constexpr float kLargest = std::numeric_limits<float>::max();
-    CollectedDepths collected{depths.data(), kLargest, -kLargest};
+    float* out = depths.data();
+    const cv::v_float32x4 largest = cv::v_setall_f32(kLargest);
+    cv::v_float32x4 low = largest;
+    cv::v_float32x4 high = cv::v_setall_f32(-kLargest);
+    float lowest = kLargest;
+    float highest = -kLargest;
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
-      collected = kernels_.collect_finite(depth_mm.ptr<float>(row) + roi.x, roi.width, collected);
+      const float* depth = depth_mm.ptr<float>(row) + roi.x;
+      int col = 0;
+      for (; col + 4 <= roi.width; col += 4) {
+        const cv::v_float32x4 four = cv::v_load(depth + col);
+        const cv::v_float32x4 finite = cv::v_abs(four) <= largest;  // NaN, inf: false
+        low = cv::v_select(finite, cv::v_min(four, low), low);
+        high = cv::v_select(finite, cv::v_max(four, high), high);
+        const int lanes = cv::v_signmask(finite);
+        if (lanes == 0xF) {
+          cv::v_store(out, four);
+          out += 4;
+        } else if (lanes != 0) {
+          for (int lane = 0; lane < 4; ++lane) {
+            if ((lanes >> lane) & 1) *out++ = depth[col + lane];
+          }
+        }
+      }
+      for (; col < roi.width; ++col) {
+        const float value = depth[col];
+        if (!(std::abs(value) <= kLargest)) continue;
+        *out++ = value;
+        lowest = std::min(lowest, value);
+        highest = std::max(highest, value);
+      }
     }
-    const auto count = static_cast<std::size_t>(collected.end - depths.data());
-    return {{depths.data(), count}, collected.lowest, collected.highest};
+    lowest = std::min(lowest, cv::v_reduce_min(low));
+    highest = std::max(highest, cv::v_reduce_max(high));
+    return {{depths.data(), static_cast<std::size_t>(out - depths.data())}, lowest, highest};
   }
 
   // The trimmed mean, the median and the spread from one histogram of the depths and one
@@ -158,7 +189,6 @@ class GroundDistanceEstimator final : public Transform {
     out.confidence = confidence(out.soil_fraction, out.spread_mm);
   }
 
-  const SoilKernels& kernels_ = *available_soil_kernels().front();
   const RegionOfInterest region_;
   const Statistic statistic_;
   const double trim_fraction_;

@@ -144,16 +144,18 @@ TEST_F(NoisySoilWithOutliers, TrimmedMeanIsTheTruncatedNormalMean) {
 }
 
 // The statistics found through a histogram of the depths are those of the sorted depths,
-// to the last bit, with 40 % of the region masked as residue.
+// to the last bit, with 40 % of the region masked as residue and 2 % infinite (no soil).
 TEST_F(NoisySoilWithOutliers, StatisticsAreThoseOfTheSortedDepths) {
   cv::Mat soil = depth_.clone();
   cv::Mat residue(soil.size(), CV_8UC1);
   cv::RNG(2).fill(residue, cv::RNG::UNIFORM, 0, 100);
   soil.setTo(kNaN, residue < 40);
+  soil.setTo(std::numeric_limits<float>::infinity(), residue == 50);
+  soil.setTo(-std::numeric_limits<float>::infinity(), residue == 51);
   std::vector<float> depths;
   for (int v = kDefaultRoi.y; v < kDefaultRoi.y + kDefaultRoi.height; ++v) {
     for (int u = kDefaultRoi.x; u < kDefaultRoi.x + kDefaultRoi.width; ++u) {
-      if (!std::isnan(soil.at<float>(v, u))) depths.push_back(soil.at<float>(v, u));
+      if (std::isfinite(soil.at<float>(v, u))) depths.push_back(soil.at<float>(v, u));
     }
   }
   const auto median_of = [](std::vector<float> values) {
