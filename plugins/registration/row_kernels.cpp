@@ -15,7 +15,7 @@
 
 #include "camera_geometry/lens_model.h"
 #include "row_kernels.h"
-#include "tilth/kernel_level.h"
+#include "kernel_levels/kernel_level.h"
 
 static_assert(std::endian::native == std::endian::little, "pixels' bytes are read as words");
 

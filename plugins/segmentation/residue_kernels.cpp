@@ -13,7 +13,7 @@
 #endif
 
 #include "residue_kernels.h"
-#include "tilth/kernel_level.h"
+#include "kernel_levels/kernel_level.h"
 #include "tilth/messages/residue_mask.h"
 
 #if defined(__AVX512F__) && !defined(__AVX512BW__)

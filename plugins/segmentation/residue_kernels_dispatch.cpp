@@ -1,6 +1,6 @@
 // The levels of residue_kernels.cpp that were built (see cmake/TilthKernelLevels.cmake).
 #include "residue_kernels.h"
-#include "tilth/kernel_levels.h"
+#include "kernel_levels/kernel_levels.h"
 
 namespace tilth::segmentation {
 

@@ -15,6 +15,7 @@
 #include "mcap/mcap_recording.h"
 #include "mcap/raw_image.h"
 #include "mcap_fixture.h"
+#include "tilth/version.h"
 
 namespace tilth::testing {
 namespace {
@@ -153,8 +154,10 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   ASSERT_EQ(reader.metadata().size(), 2u);
   EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("json"),
             read_text(calibration_file_));
-  const std::map<std::string, std::string> recording{
-      {"node", "w"}, {"graph_file", "recorded.graph.json"}, {"log_time", "host"}};
+  const std::map<std::string, std::string> recording{{"node", "w"},
+                                                     {"graph_file", "recorded.graph.json"},
+                                                     {"log_time", "host"},
+                                                     {"tilth_version", std::string(version())}};
   EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values, recording);
 
   // The first colour message: a RawImage in CDR, byte by byte where it is not pixels.

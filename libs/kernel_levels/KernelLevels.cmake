@@ -2,10 +2,9 @@
 # Builds the static library NAME from SOURCES compiled once per instruction-set level --
 # the baseline (on x86-64, -march=x86-64: SSE2) and x86-64-v2 (SSE4.2), x86-64-v3 (AVX2,
 # FMA) and x86-64-v4 (AVX-512), each with -march=<level> -- and DISPATCH, compiled once, which picks among
-# them (tilth/kernel_levels.h). SOURCES see TILTH_KERNEL_LEVEL, the level's namespace
+# them (kernel_levels/kernel_levels.h). SOURCES see TILTH_KERNEL_LEVEL, the level's namespace
 # (baseline, x86_64_v2, ...), and TILTH_KERNEL_LEVEL_NAME, its name; DISPATCH sees
-# TILTH_KERNEL_LEVELS_X86_64 where the x86-64 levels are built. Used in this tree and,
-# through find_package(Tilth), by plugins built out of tree.
+# TILTH_KERNEL_LEVELS_X86_64 where the x86-64 levels are built. Internal to this tree.
 function(tilth_add_kernel_levels name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DISPATCH;LIBRARIES" ${ARGN})
   set(levels baseline)
@@ -27,13 +26,13 @@ function(tilth_add_kernel_levels name)
     elseif(x86_64)
       target_compile_options(${target} PRIVATE -march=x86-64)  # whatever the default flags
     endif()
-    target_link_libraries(${target} PRIVATE Tilth::sdk ${ARG_LIBRARIES})
+    target_link_libraries(${target} PRIVATE tilth_lib_kernel_levels ${ARG_LIBRARIES})
     list(APPEND objects $<TARGET_OBJECTS:${target}>)
     list(APPEND targets ${target})
   endforeach()
   add_library(${name} STATIC ${objects} ${ARG_DISPATCH})
   target_include_directories(${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
-  target_link_libraries(${name} PUBLIC Tilth::sdk ${ARG_LIBRARIES})
+  target_link_libraries(${name} PUBLIC tilth_lib_kernel_levels ${ARG_LIBRARIES})
   if(x86_64)
     target_compile_definitions(${name} PRIVATE TILTH_KERNEL_LEVELS_X86_64)
   endif()

@@ -1,5 +1,5 @@
 // What a kernel source compiled once per instruction-set level (tilth_add_kernel_levels,
-// tilth/kernel_levels.h) sees of the level it is compiled for: the 32-bit lanes of one
+// kernel_levels.h) sees of the level it is compiled for: the 32-bit lanes of one
 // vector register. A constant, not a function, so that each compilation has its own.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "tilth/kernel_levels.h"
+#include "kernel_levels/kernel_levels.h"
 
 namespace tilth {
 
