@@ -1,5 +1,6 @@
-// What a Tilth MCAP recording holds: its channels, the calibration attachment and
-// metadata, so the writer, the player and the tools agree on the names.
+// What a Tilth MCAP recording holds (docs/formats/mcap-recording.md): its channels, the
+// calibration attachment and metadata, so the writer, the player and the tools agree on
+// the names.
 #pragma once
 
 #include <string_view>
