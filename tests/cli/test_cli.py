@@ -23,6 +23,11 @@ class HelpAndInspection(unittest.TestCase):
             result = tilth(command, "--help")
             self.assertEqual(result.returncode, 0, command)
             self.assertIn("usage: tilth " + command, result.stdout)
+            self.assertEqual(tilth(command, "-h").stdout, result.stdout, command)
+        for command in ["simulate", "recording", "ab", "train-segmenter"]:
+            result = tilth(command, "-h")
+            self.assertEqual(result.returncode, 0, (command, result.stderr))
+            self.assertIn("usage: tilth " + command, result.stdout)
         self.assertEqual(tilth("--help").returncode, 0)
         self.assertEqual(tilth("frobnicate").returncode, 2)
 

@@ -45,6 +45,8 @@ CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::s
       values_.emplace(arg, inline_value ? *inline_value : argv[++i]);
     } else if (flags.count(arg)) {
       flags_.insert(arg);
+    } else if (arg == "-h" && flags.count("--help")) {
+      flags_.insert("--help");
     } else if (arg.starts_with("-") && arg != "-") {
       throw Error("unknown option " + arg + " (see --help)");
     } else {

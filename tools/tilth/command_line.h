@@ -13,8 +13,8 @@ namespace tilth::cli {
 
 class CommandLine {
  public:
-  // `valued` options take the next argument (--set k=v); `flags` take none. Throws
-  // tilth::Error for an unknown option or a missing value.
+  // `valued` options take the next argument (--set k=v); `flags` take none; -h is --help
+  // where --help is a flag. Throws tilth::Error for an unknown option or a missing value.
   CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
               const std::set<std::string>& flags);
 
