@@ -10,9 +10,9 @@
 
 #include "estimators.h"
 #include "source_tree.h"
-#include "stage_harness.h"
 #include "synthetic_ground.h"
 #include "tilth/messages/depth_image.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::estimation {
 namespace {

@@ -8,9 +8,9 @@
 #include <opencv2/core.hpp>
 
 #include "color_threshold.h"
-#include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
+#include "tilth/testing/stage_harness.h"
 #include "variants.h"
 
 namespace tilth::segmentation {

@@ -19,11 +19,11 @@
 #include "camera_stages.h"
 #include "fake_camera.h"
 #include "fake_pattern.h"
-#include "stage_harness.h"
 #include "tilth/log.h"
 #include "tilth/messages/camera_status.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::aravis {
 namespace {

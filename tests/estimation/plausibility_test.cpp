@@ -11,10 +11,10 @@
 
 #include "estimators.h"
 #include "source_tree.h"
-#include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/ground_distance.h"
 #include "tilth/messages/registered_color.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::estimation {
 namespace {

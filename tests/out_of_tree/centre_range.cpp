@@ -1,23 +1,9 @@
-// Example plugin: the range (gray * mm per gray) at the pixel nearest the image centre,
-// as a message type of the plugin's own.
-#include <sstream>
-
+// example.centre_range: the range (gray * mm per gray) at one pixel of a raw ToF frame.
+#include "centre_range.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/plugin.h"
 
 namespace example {
-
-struct CentreRange : tilth::MessageOf<CentreRange> {
-  static constexpr std::string_view kTypeName = "example.CentreRange";
-  double range_mm = 0.0;
-  std::string summary() const override {
-    std::ostringstream out;
-    out.setf(std::ios::fixed);
-    out.precision(2);
-    out << "centre range " << range_mm << " mm";
-    return out.str();
-  }
-};
 
 class CentreRangeStage final : public tilth::Transform {
  public:
@@ -39,7 +25,7 @@ class CentreRangeStage final : public tilth::Transform {
   const int v_;
 };
 
-tilth::StageDescriptor describe() {
+tilth::StageDescriptor describe_centre_range() {
   tilth::StageDescriptor d;
   d.type = "example.centre_range";
   d.summary = "range at one pixel of a raw ToF frame";
@@ -60,5 +46,4 @@ tilth::StageDescriptor describe() {
 
 }  // namespace example
 
-TILTH_PLUGIN("example")
-TILTH_STAGE(example::describe());
+TILTH_STAGE(example::describe_centre_range());

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the SDK from the build tree into a scratch prefix, builds the example plugin
-# against it out of tree, and runs it in a graph with the in-tree plugins.
+# against it out of tree, and runs it in a graph with the in-tree plugins and its stage
+# alone through the SDK's stage harness.
 # usage: run_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$1
@@ -30,4 +31,8 @@ if [ "$out" != "$expected" ]; then
   echo "FAIL: expected"; echo "$expected"; exit 1
 fi
 echo "out-of-tree plugin OK"
+
+# The stage alone, through the SDK's stage harness.
+LD_LIBRARY_PATH="$scratch/prefix/lib" "$scratch/build/centre_range_check"
+echo "out-of-tree stage harness OK"
 

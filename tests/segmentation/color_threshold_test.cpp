@@ -15,10 +15,10 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
 #include "tilth/messages/residue_mask.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::segmentation {
 namespace {

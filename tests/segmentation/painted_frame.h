@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "stage_harness.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
 #include "tilth/messages/residue_mask.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::segmentation {
 

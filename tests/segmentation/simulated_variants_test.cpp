@@ -16,9 +16,9 @@
 #include "pixel_classifier/classifier_model.h"
 #include "segmenter_training.h"
 #include "simulated_frames.h"
-#include "stage_harness.h"
 #include "temp_dir.h"
 #include "tilth/messages/residue_mask.h"
+#include "tilth/testing/stage_harness.h"
 #include "variants.h"
 
 namespace tilth::segmentation {

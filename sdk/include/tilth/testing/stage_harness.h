@@ -1,6 +1,8 @@
-// Makes a stage from its descriptor with the parameters the graph loader would give it,
-// and runs frames through it, for the tests and benchmarks of the measurement-chain
-// plugins (which link the stage objects directly instead of loading the plugin).
+// Runs one stage outside a graph, for a plugin's own tests and benchmarks (as MediaPipe's
+// CalculatorRunner and GStreamer's GstHarness do): the stage is made from its descriptor
+// with the parameters the graph loader would give it, and frames go through it one by one.
+// Link the plugin's stages (tilth_add_plugin's tilth_NAME_stages) and a TILTH_PLUGIN of
+// the test's own.
 #pragma once
 
 #include <algorithm>
