@@ -112,8 +112,7 @@ class Runtime::Impl {
   Impl(ValidatedGraph graph, const StageRegistry& registry, RunLimits limits)
       : graph_(std::move(graph)), limits_(limits) {
     if (!graph_.open_inputs.empty()) {
-      throw Error(graph_.file.string() + ": a fragment: nothing feeds its inputs " +
-                  quoted_list(graph_.open_inputs) +
+      throw Error("a fragment: nothing feeds its inputs " + quoted_list(graph_.open_inputs) +
                   "; run a graph that includes it and feeds them (docs/graph-format.md)");
     }
     make_stages(registry);

@@ -225,9 +225,8 @@ TEST_F(GraphValidatorTest, AFragmentCannotRun) {
     FAIL() << "a fragment ran";
   } catch (const Error& error) {
     EXPECT_EQ(std::string(error.what()),
-              file_.string() +
-                  ": a fragment: nothing feeds its inputs 'left (sum.a)', 'right (sum.b)'; run a "
-                  "graph that includes it and feeds them (docs/graph-format.md)");
+              "a fragment: nothing feeds its inputs 'left (sum.a)', 'right (sum.b)'; run a graph "
+              "that includes it and feeds them (docs/graph-format.md)");
   }
 }
 
