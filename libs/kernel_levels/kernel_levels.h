@@ -1,6 +1,6 @@
 // Kernels compiled once per instruction-set level (tilth_add_kernel_levels in
-// cmake/TilthKernelLevels.cmake), and the choice among them when a stage starts: the
-// widest level this CPU runs, or one named by hand for comparisons. So one build runs on
+// KernelLevels.cmake), and the choice among them when a stage starts: the widest level
+// this CPU runs, or one named by hand for comparisons. So one build runs on
 // any x86-64 PC and still uses AVX-512 where there is one.
 #pragma once
 

@@ -14,8 +14,8 @@
 #endif
 
 #include "camera_geometry/lens_model.h"
-#include "row_kernels.h"
 #include "kernel_levels/kernel_level.h"
+#include "row_kernels.h"
 
 static_assert(std::endian::native == std::endian::little, "pixels' bytes are read as words");
 

@@ -1,6 +1,6 @@
-// The levels of row_kernels.cpp that were built (see cmake/TilthKernelLevels.cmake).
-#include "row_kernels.h"
+// The levels of row_kernels.cpp that were built (see libs/kernel_levels/KernelLevels.cmake).
 #include "kernel_levels/kernel_levels.h"
+#include "row_kernels.h"
 
 namespace tilth::registration {
 

@@ -12,8 +12,8 @@
 #include <immintrin.h>
 #endif
 
-#include "residue_kernels.h"
 #include "kernel_levels/kernel_level.h"
+#include "residue_kernels.h"
 #include "tilth/messages/residue_mask.h"
 
 #if defined(__AVX512F__) && !defined(__AVX512BW__)

@@ -1,7 +1,7 @@
 // The residue segmentation's per-row loops that gain from wide vectors: the in-range
-// test of a colour box (ColorRangeTable), and the rows of the outputs. residue_kernels.cpp is
-// compiled once per instruction-set level (tilth/kernel_levels.h); the stages use the widest the
-// CPU runs.
+// test of a colour box (ColorRangeTable), and the rows of the outputs. residue_kernels.cpp
+// is compiled once per instruction-set level (kernel_levels/kernel_levels.h); the stages
+// use the widest the CPU runs.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
-// The levels of residue_kernels.cpp that were built (see cmake/TilthKernelLevels.cmake).
-#include "residue_kernels.h"
+// The levels of residue_kernels.cpp that were built (see libs/kernel_levels/KernelLevels.cmake).
 #include "kernel_levels/kernel_levels.h"
+#include "residue_kernels.h"
 
 namespace tilth::segmentation {
 
