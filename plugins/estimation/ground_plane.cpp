@@ -358,6 +358,12 @@ class GroundPlaneEstimator final : public Transform {
       if (weight < kNegligibleWeight) continue;
       points.push_back({x, y, z, weight, nearness(x, y, tool_area_mm_)});
     }
+    // No soil within the tool area (residue covers it): the soil nearest the tool, by the
+    // fit's weights, decides the level.
+    if (std::none_of(points.begin(), points.end(),
+                     [](const SoilPoint& point) { return point.vote >= kNegligibleWeight; })) {
+      for (SoilPoint& point : points) point.vote = point.weight;
+    }
     const std::optional<Tilt> tilt = ground_tilt(grid, sampling.grid_columns);
     if (!tilt || points.size() < 6) {
       out.invalidate(InvalidCause::kTooLittleSoil,

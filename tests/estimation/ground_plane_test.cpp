@@ -186,6 +186,33 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
   EXPECT_NEAR(beyond.distance_mm, testing::plane_distance_at(far_level, 40.0, 0.0), 0.3);
 }
 
+// Residue covers the tool area (no soil within 50 mm of the tool point, five times
+// tool_area_mm): the soil around it, nearest first, decides the level, and the distance is
+// read on it as next to a step. (Once the level was read from an empty list: a read out
+// of bounds, ASan's heap-buffer-overflow.)
+TEST(GroundPlane, SoilOnlyAroundACoveredToolAreaDecidesTheLevel) {
+  GroundScene scene;
+  scene.tilt_x_deg = 2.0;
+  scene.noise_mm = 1.0;
+  const DepthCameraCalibration& camera = paper_camera();
+  cv::Mat depth = testing::render(scene, camera);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const double z_mm = depth.at<float>(v, u) + camera.z_offset_mm;
+      const double x_mm = (u - camera.cx) / camera.fx * z_mm;
+      const double y_mm = (v - camera.cy) / camera.fy * z_mm;
+      if (std::hypot(x_mm, y_mm) < 50.0) depth.at<float>(v, u) = std::nanf("");
+    }
+  }
+  const GroundDistance out = fit_plane(depth, {{"neighbourhood_mm", 40},
+                                               {"tool_area_mm", 10},
+                                               {"stride", 2},
+                                               {"outlier_threshold_mm", 3},
+                                               {"min_inlier_fraction", 0.35}});
+  ASSERT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_NEAR(out.distance_mm, scene.distance_mm, 0.3);
+}
+
 TEST(GroundPlane, TooLittleVisibleSoilIsInvalid) {
   const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   const GroundDistance out = fit_plane(depth);
