@@ -429,9 +429,13 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
       store(keys + i,
             y * row_key + x * column_key + (-(y & 1) & odd_row) + (-(x & 1) & odd_column));
     }
-    // Shown points have -0.5 <= u < width - 0.5: u + 0.5 truncates to its floor.
-    const Ints cell = __builtin_convertvector((v + half) * per_cell, Ints) * columns +
-                      __builtin_convertvector((u + half) * per_cell, Ints);
+    // Shown points have -0.5 <= u < width - 0.5: u + 0.5 truncates to its floor. A point
+    // not shown (NaN) converts to INT_MIN, whose product with the columns overflows: the
+    // cell is computed in unsigned (wrapping) arithmetic and replaced by the outside cell.
+    const Words row = reinterpret_cast<Words>(__builtin_convertvector((v + half) * per_cell, Ints));
+    const Words column =
+        reinterpret_cast<Words>(__builtin_convertvector((u + half) * per_cell, Ints));
+    const Ints cell = reinterpret_cast<Ints>(row * reinterpret_cast<Words>(columns) + column);
     store(cell_indices + i, depth == depth ? cell : outside);  // NaN: not shown
   }
 }
