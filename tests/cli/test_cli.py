@@ -5,7 +5,7 @@ import re
 import signal
 import subprocess
 import tempfile
-import time
+import threading
 import unittest
 
 TILTH = os.environ["TILTH_BIN"]
@@ -171,9 +171,17 @@ class Run(unittest.TestCase):
             [TILTH, "run", PLANE, "--set", "camera.fps=100", "--set", "print.every=1",
              "--set", "runtime.when_full=block"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        time.sleep(1.5)
+        # The signal comes once 21 frames are out, however long starting took (a sanitizer
+        # build starts slowly); a run that prints nothing for a minute is killed.
+        watchdog = threading.Timer(60, process.kill)
+        watchdog.start()
+        printed = []
+        while len(printed) <= 20 and (line := process.stdout.readline()):
+            printed.append(line)
+        watchdog.cancel()
         process.send_signal(signum)
         out, err = process.communicate(timeout=30)
+        out = "".join(printed) + out
         self.assertEqual(process.returncode, 0, err)
         frames = [int(m.group(1)) for m in re.finditer(r"^frame (\d+):", out, re.M)]
         self.assertGreater(len(frames), 20)

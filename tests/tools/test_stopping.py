@@ -21,9 +21,17 @@ from rigs import quarter_rig  # noqa: E402
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
 PLUGIN_PATH = os.environ["TILTH_TEST_PLUGIN_PATH"]
-PRELOAD = os.environ["EARLY_THREAD_PRELOAD"]
 
-CSV_FIELDS = 12
+
+def sanitizer_runtimes(program):
+    """The sanitizer runtimes `program` links (libasan in an ASan build): they must come
+    before any other library in LD_PRELOAD."""
+    linked = subprocess.run(["ldd", program], stdout=subprocess.PIPE, text=True).stdout
+    return [line.split("=>")[1].split()[0] for line in linked.splitlines()
+            if re.match(r"\s*lib[alt]san\.so", line)]
+
+
+PRELOAD = ":".join(sanitizer_runtimes(TILTH) + [os.environ["EARLY_THREAD_PRELOAD"]])
 SECOND_SIGNAL = "second stop signal: exiting at once (code 130)"
 LIBC = ctypes.CDLL(None, use_errno=True)
 
@@ -105,7 +113,7 @@ def whole_csv_rows(test, path):
     test.assertTrue(lines[0].startswith("index,"), lines[0])
     for i, line in enumerate(lines[1:]):
         fields = line.split(",")
-        test.assertEqual(len(fields), CSV_FIELDS, line)
+        test.assertEqual(len(fields), len(lines[0].split(",")), line)
         test.assertEqual(int(fields[0]), i)
         float(fields[3]), float(fields[9])  # noqa: B018 (parses)
     return len(lines) - 1
