@@ -1,11 +1,11 @@
 // Writes one CSV row per frame: the frame, its capture times, the ground distance with
-// its validity, the cause when invalid, its quality, the latency from capture, and the
-// ground truth when a truth input is connected. Each row is one write(2), so a killed
-// process loses at most the row being written. A row the disk does not take (full) is
-// cut back off the file, reported as lost data, and the rows after it are written when
-// the disk takes them: the file only ever holds whole rows. With rotation by size or
-// age, rows go on in numbered files (run.csv, run.1.csv, run.2.csv, ...), each starting
-// with the header (docs/sinks.md).
+// its validity, the cause when invalid, its quality, the latency from capture, the
+// ground truth when a truth input is connected, and the Tilth release that measured it.
+// Each row is one write(2), so a killed process loses at most the row being written. A
+// row the disk does not take (full) is cut back off the file, reported as lost data, and
+// the rows after it are written when the disk takes them: the file only ever holds whole
+// rows. With rotation by size or age, rows go on in numbered files (run.csv, run.1.csv,
+// run.2.csv, ...), each starting with the header (docs/sinks.md).
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -23,13 +23,14 @@
 #include "tilth/messages/ground_distance.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/plugin.h"
+#include "tilth/version.h"
 
 namespace tilth::sinks {
 namespace {
 
 constexpr std::string_view kHeader =
     "index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
-    "soil_pixels,spread_mm,confidence,latency_ms,truth_mm\n";
+    "soil_pixels,spread_mm,confidence,latency_ms,truth_mm,tilth_version\n";
 
 // File `number` of a rotated series: the path itself, then "<stem>.<number><extension>".
 std::filesystem::path numbered(const std::filesystem::path& path, std::uint64_t number) {
@@ -87,7 +88,7 @@ class Csv final : public Sink {
                distance.valid ? "" : to_string(distance.cause).data(), distance.soil_fraction,
                static_cast<long long>(distance.soil_pixels), distance.spread_mm,
                distance.confidence, latency_ms) +
-        truth + "\n";
+        truth + "," + std::string(version()) + "\n";
     if (file_ >= 0 && full_before(row)) {
       ++number_;
       close();  // when this throws, the next row still goes to the next file

@@ -15,9 +15,11 @@ import unittest
 
 TILTH = os.environ["TILTH_BIN"]
 PLUGIN_DIR = os.environ["TILTH_TEST_PLUGIN_DIR"]
+with open(os.path.join(os.environ["TILTH_SOURCE_DIR"], "CMakeLists.txt")) as cmake_lists:
+    RELEASE = re.search(r"project\(Tilth VERSION ([0-9.]+)", cmake_lists.read()).group(1)
 
 HEADER = ("index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
-          "soil_pixels,spread_mm,confidence,latency_ms,truth_mm")
+          "soil_pixels,spread_mm,confidence,latency_ms,truth_mm,tilth_version")
 FIELDS = HEADER.split(",")
 
 
@@ -94,6 +96,7 @@ class Rows(unittest.TestCase):
             self.assertEqual(row["confidence"], "%.3f" % (i / 100 + 0.005))
             self.assertGreaterEqual(float(row["latency_ms"]), 0.0)
             self.assertEqual(row["truth_mm"], "")  # no truth input connected
+            self.assertEqual(row["tilth_version"], RELEASE)
 
 
 class Rotation(unittest.TestCase):

@@ -1,5 +1,5 @@
-// The Tilth release this SDK belongs to, stamped into what Tilth writes (MCAP metadata,
-// A/B reports) and printed by `tilth --version`.
+// The Tilth release this SDK belongs to, stamped into what Tilth writes (CSV rows, MCAP
+// metadata, A/B reports) and printed by `tilth --version`.
 #pragma once
 
 #include <string_view>
