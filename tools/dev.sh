@@ -1,11 +1,10 @@
 #!/usr/bin/env bash
 # The two front-door commands (see README.md):
 #   bash tools/dev.sh demo   install what is missing, build, run the built-in demo graph
-#   bash tools/dev.sh test   install what is missing, build, run every test, every test
-#                            again under ASan+UBSan, the runtime and the parallel stages
-#                            under TSan, and each fuzz target for TILTH_FUZZ_SECONDS
-#                            (default 60) seconds (docs/reliability.md)
-#   bash tools/dev.sh sanitize   only the ASan+UBSan part of `test`
+#   bash tools/dev.sh test   install what is missing, build, run every test, the runtime
+#                            and the parallel stages under TSan, and each fuzz target for
+#                            TILTH_FUZZ_SECONDS (default 60) seconds (docs/reliability.md)
+#   bash tools/dev.sh sanitize   every test again under ASan+UBSan
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,20 +33,15 @@ step() {
   echo "dev.sh: '$*' took $((SECONDS - start)) s"
 }
 
-# Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
-sanitize() {
+if [ "$mode" = sanitize ]; then
+  # Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
   cmake --preset asan >/dev/null
   step cmake --build --preset asan
   step ctest --preset asan
-}
-
-if [ "$mode" = sanitize ]; then
-  sanitize
   exit 0
 fi
 
 step ctest --preset default
-sanitize
 # The runtime's tests and every parallel stage under ThreadSanitizer.
 cmake --preset tsan >/dev/null
 step cmake --build --preset tsan
