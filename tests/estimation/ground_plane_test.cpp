@@ -53,6 +53,15 @@ GroundDistance fit_plane(const cv::Mat& soil_mm, const json& params = json::obje
   return stage.run({depth_message(soil_mm)})[0].get<GroundDistance>();
 }
 
+// The estimation's parameters in graphs/measurement-chain.json.
+json chain_params() {
+  return {{"neighbourhood_mm", 40},
+          {"tool_area_mm", 10},
+          {"stride", 2},
+          {"outlier_threshold_mm", 3},
+          {"min_inlier_fraction", 0.35}};
+}
+
 const DepthCameraCalibration& paper_camera() {
   static const DepthCameraCalibration camera = load_calibration(kPaperRig).depth;
   return camera;
@@ -166,22 +175,15 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
       if (x_mm > 15.0) depth.at<float>(v, u) = far.at<float>(v, u);
     }
   }
-  const GroundDistance out = fit_plane(depth, {{"neighbourhood_mm", 40},
-                                               {"tool_area_mm", 10},
-                                               {"stride", 2},
-                                               {"outlier_threshold_mm", 3},
-                                               {"min_inlier_fraction", 0.35}});
+  const GroundDistance out = fit_plane(depth, chain_params());
   ASSERT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(out.distance_mm, near_level.distance_mm, 0.3);
   EXPECT_NEAR(*out.tilt_x_deg, 2.0, 0.2);
   EXPECT_NEAR(*out.tilt_y_deg, 0.0, 0.2);
 
-  const GroundDistance beyond = fit_plane(depth, {{"tool_point", {40.0, 0.0}},
-                                                  {"neighbourhood_mm", 40},
-                                                  {"tool_area_mm", 10},
-                                                  {"stride", 2},
-                                                  {"outlier_threshold_mm", 3},
-                                                  {"min_inlier_fraction", 0.35}});
+  json beside_the_step = chain_params();
+  beside_the_step["tool_point"] = {40.0, 0.0};
+  const GroundDistance beyond = fit_plane(depth, beside_the_step);
   ASSERT_TRUE(beyond.valid) << beyond.invalid_reason;
   EXPECT_NEAR(beyond.distance_mm, testing::plane_distance_at(far_level, 40.0, 0.0), 0.3);
 }
@@ -204,11 +206,7 @@ TEST(GroundPlane, SoilOnlyAroundACoveredToolAreaDecidesTheLevel) {
       if (std::hypot(x_mm, y_mm) < 50.0) depth.at<float>(v, u) = std::nanf("");
     }
   }
-  const GroundDistance out = fit_plane(depth, {{"neighbourhood_mm", 40},
-                                               {"tool_area_mm", 10},
-                                               {"stride", 2},
-                                               {"outlier_threshold_mm", 3},
-                                               {"min_inlier_fraction", 0.35}});
+  const GroundDistance out = fit_plane(depth, chain_params());
   ASSERT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(out.distance_mm, scene.distance_mm, 0.3);
 }
