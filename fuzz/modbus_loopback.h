@@ -39,9 +39,10 @@ struct HalfCloseOutcome {
 
 // Connects from `source` (an IPv4 loopback address, host byte order) to the server on
 // 127.0.0.1:`port`, sends `request`, closes its sending side and reads every reply until
-// the server closes, `timeout` has passed since the half-close, or more than
-// `max_reply_bytes` arrived. Signals (libFuzzer's SIGALRM) interrupt none of the waits.
-// Throws tilth::Error when it cannot connect within `timeout`.
+// the server closes, `timeout` has passed since the half-close (not counting the time this
+// process waited for a CPU on a loaded machine), or more than `max_reply_bytes` arrived. Signals
+// (libFuzzer's SIGALRM) interrupt none of the waits. Throws tilth::Error when it cannot connect
+// within `timeout`.
 HalfCloseOutcome half_close_session(std::uint32_t source, int port,
                                     std::span<const std::uint8_t> request,
                                     std::chrono::milliseconds timeout, std::size_t max_reply_bytes);

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The two front-door commands (see README.md):
 #   bash tools/dev.sh demo   install what is missing, build, run the built-in demo graph
-#   bash tools/dev.sh test   install what is missing, build, run every test, the runtime
-#                            and the parallel stages under TSan, and each fuzz target for
-#                            TILTH_FUZZ_SECONDS (default 60) seconds (docs/reliability.md)
-#   bash tools/dev.sh sanitize   every test again under ASan+UBSan
+#   bash tools/dev.sh test   install what is missing, build, run every test; every test
+#                            again under ASan+UBSan; the threaded code under TSan; and each
+#                            fuzz target for TILTH_FUZZ_SECONDS (default 60) seconds
+#                            (docs/reliability.md)
+#   bash tools/dev.sh sanitize   only the ASan+UBSan part of `test`
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -33,16 +34,21 @@ step() {
   echo "dev.sh: '$*' took $((SECONDS - start)) s"
 }
 
-if [ "$mode" = sanitize ]; then
-  # Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# Every test again under AddressSanitizer + UndefinedBehaviorSanitizer.
+asan() {
   cmake --preset asan >/dev/null
   step cmake --build --preset asan
   step ctest --preset asan
+}
+
+if [ "$mode" = sanitize ]; then
+  asan
   exit 0
 fi
 
 step ctest --preset default
-# The runtime's tests and every parallel stage under ThreadSanitizer.
+asan
+# The runtime, every parallel stage and the threaded serial stages under ThreadSanitizer.
 cmake --preset tsan >/dev/null
 step cmake --build --preset tsan
 step ctest --preset tsan

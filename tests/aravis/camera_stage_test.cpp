@@ -290,14 +290,20 @@ StreamRecord stream_for(CameraStage& camera, std::chrono::milliseconds duration,
   return record;
 }
 
+// The stream buffers of a camera stage in these tests (the stage's default, set here).
+constexpr int kStreamBuffers = 8;
+
 // Every frame the simulator sent, whole and in order, one every 33.3 ms by its clock;
 // except that a frame the simulator paused in the middle of comes incomplete (Aravis waits
-// 100 ms for its missing packets), which its own clock shows.
+// 100 ms for its missing packets), which its own clock shows; and that a frame is late
+// (dropped, counted) when this test, starved on a loaded machine, kept all the stream's
+// buffers waiting, which the latency of the frames before it shows.
 void expect_every_frame_at_30_fps(const StreamRecord& record, const std::string& what) {
   ASSERT_GE(record.frames.size(), 2u) << what;
   constexpr double kPeriodMs = 1000.0 / 30.0;
   std::vector<double> periods_ms;
   std::uint64_t skipped = 0;
+  std::uint64_t skipped_without_pause = 0;
   for (std::size_t i = 1; i < record.frames.size(); ++i) {
     const auto& before = record.frames[i - 1].info;
     const auto& after = record.frames[i].info;
@@ -305,10 +311,10 @@ void expect_every_frame_at_30_fps(const StreamRecord& record, const std::string&
         static_cast<double>(after.device_timestamp_ns - before.device_timestamp_ns) / 1e6;
     const std::uint64_t missing = (after.frame_id + 65535 - before.frame_id - 1) % 65535;
     if (missing > 0) {
-      std::printf("the simulator paused %.0f ms: %llu incomplete\n", period_ms,
-                  static_cast<unsigned long long>(missing));
-      EXPECT_GT(period_ms, (static_cast<double>(missing) + 2.0) * kPeriodMs - 10.0)
-          << what << ": frames missing at frame " << i;
+      std::printf("%llu frames missing over %.0f ms\n", static_cast<unsigned long long>(missing),
+                  period_ms);
+      if (period_ms <= (static_cast<double>(missing) + 2.0) * kPeriodMs - 10.0)
+        skipped_without_pause += missing;
     }
     skipped += missing;
     periods_ms.push_back(period_ms);
@@ -324,9 +330,16 @@ void expect_every_frame_at_30_fps(const StreamRecord& record, const std::string&
   const CameraStatus& first = record.first_status;
   const CameraStatus& last = record.last_status;
   EXPECT_TRUE(last.streaming) << what;
-  EXPECT_EQ(last.incomplete - first.incomplete, skipped) << what;
+  const std::uint64_t late = last.late - first.late;
+  EXPECT_EQ(last.incomplete - first.incomplete + late, skipped) << what;
+  EXPECT_LE(skipped_without_pause, late)
+      << what << ": frames missing with no pause of the simulator";
+  if (late > 0) {
+    EXPECT_GT(*std::max_element(record.latency_ms.begin(), record.latency_ms.end()),
+              (kStreamBuffers - 1) * kPeriodMs - 10.0)
+        << what << ": " << late << " frames late although this test kept up with the stream";
+  }
   EXPECT_EQ(last.lost - first.lost, 0u) << what;
-  EXPECT_EQ(last.late - first.late, 0u) << what;
   EXPECT_EQ(last.completed - first.completed + 1, record.frames.size()) << what;
 }
 
@@ -335,10 +348,12 @@ TEST(AravisCamera, StreamsMono16AndBayerFromTwoCamerasAt30FramesPerSecondWithout
   FakeCamera color_fake("127.0.0.13", "TILTH13");
   depth_fake.start();
   color_fake.start();
-  CameraStage depth(describe_tof_camera(),
-                    loopback(depth_fake, {{"pixel_format", "Mono16"}, {"frame_rate", 30}}));
-  CameraStage color(describe_color_camera(),
-                    loopback(color_fake, {{"pixel_format", "BayerRG8"}, {"frame_rate", 30}}));
+  CameraStage depth(describe_tof_camera(), loopback(depth_fake, {{"pixel_format", "Mono16"},
+                                                                 {"frame_rate", 30},
+                                                                 {"buffers", kStreamBuffers}}));
+  CameraStage color(describe_color_camera(), loopback(color_fake, {{"pixel_format", "BayerRG8"},
+                                                                   {"frame_rate", 30},
+                                                                   {"buffers", kStreamBuffers}}));
 
   // The first frames, kept whole: their pixels are the stream's own buffers.
   Produced depth_frame = depth.produce();

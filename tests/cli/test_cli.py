@@ -180,8 +180,15 @@ class Run(unittest.TestCase):
             printed.append(line)
         watchdog.cancel()
         process.send_signal(signum)
-        out, err = process.communicate(timeout=30)
-        out = "".join(printed) + out
+        # The rest through the same reader: its buffer may already hold the next frames'
+        # lines, which communicate() (reading the pipe itself) would lose. stderr is a few
+        # lines, far below a pipe's capacity, so reading stdout first cannot block tilth.
+        watchdog = threading.Timer(30, process.kill)
+        watchdog.start()
+        out = "".join(printed) + process.stdout.read(1 << 20)
+        err = process.stderr.read(1 << 20)
+        process.wait()
+        watchdog.cancel()
         self.assertEqual(process.returncode, 0, err)
         frames = [int(m.group(1)) for m in re.finditer(r"^frame (\d+):", out, re.M)]
         self.assertGreater(len(frames), 20)
