@@ -81,6 +81,50 @@ void calibrate_camera(const std::vector<std::vector<cv::Point3f>>& board,
   set_intrinsics(camera, size, matrix, distortion);
 }
 
+// One solve on the given views' corners: the rig, and each view's RMS in each camera
+// (rows: views; columns: ToF, colour).
+struct Solution {
+  RigCalibration rig;
+  cv::Mat view_errors;
+  double stereo_rms_px = 0.0;
+};
+
+Solution solve_once(const StereoCorners& corners, RigCalibration rig, cv::Size depth_size,
+                    cv::Size color_size, bool calibrate_depth) {
+  if (calibrate_depth) calibrate_camera(corners.board, corners.depth, depth_size, rig.depth);
+  calibrate_camera(corners.board, corners.color, color_size, rig.color);
+  rig.depth.width = depth_size.width;
+  rig.depth.height = depth_size.height;
+
+  // The transform with both cameras' intrinsics fixed; then, when both were calibrated
+  // here, everything refined together: the colour camera's sharper corners pin the
+  // board poses that the ToF camera's focal length and principal point depend on (on
+  // rendered views this halves their error, and T's with them).
+  cv::Mat depth_matrix(rig.depth.camera_matrix());
+  cv::Mat color_matrix(rig.color.camera_matrix());
+  cv::Mat depth_distortion(cv::Matx<double, 1, 5>(rig.depth.distortion.data()));
+  cv::Mat color_distortion(cv::Matx<double, 1, 5>(rig.color.distortion.data()));
+  cv::Mat rotation;
+  cv::Mat translation;
+  Solution solution;
+  solution.stereo_rms_px = cv::stereoCalibrate(
+      corners.board, corners.depth, corners.color, depth_matrix, depth_distortion, color_matrix,
+      color_distortion, depth_size, rotation, translation, cv::noArray(), cv::noArray(),
+      solution.view_errors, cv::CALIB_FIX_INTRINSIC);
+  if (calibrate_depth) {
+    solution.stereo_rms_px = cv::stereoCalibrate(
+        corners.board, corners.depth, corners.color, depth_matrix, depth_distortion, color_matrix,
+        color_distortion, depth_size, rotation, translation, cv::noArray(), cv::noArray(),
+        solution.view_errors, cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_USE_EXTRINSIC_GUESS);
+    set_intrinsics(rig.depth, depth_size, depth_matrix, depth_distortion);
+    set_intrinsics(rig.color, color_size, color_matrix, color_distortion);
+  }
+  rig.depth_to_color_r = cv::Matx33d(rotation.ptr<double>());
+  rig.depth_to_color_t_mm = cv::Vec3d(translation.ptr<double>());
+  solution.rig = rig;
+  return solution;
+}
+
 double median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
@@ -95,7 +139,7 @@ std::string not_found_reason(const BoardView& view) {
 
 }  // namespace
 
-SolveResult solve_rig(const std::vector<BoardView>& views, RigCalibration rig,
+SolveResult solve_rig(const std::vector<BoardView>& views, const RigCalibration& rig,
                       const SolveOptions& options, std::ostream& log) {
   if (views.empty()) throw Error("no views given");
   const bool given_sizes = rig.depth.width > 0 && rig.color.width > 0;
@@ -141,71 +185,40 @@ SolveResult solve_rig(const std::vector<BoardView>& views, RigCalibration rig,
       corners.depth.push_back(views[v].depth_corners);
       corners.color.push_back(views[v].color_corners);
     }
-    if (options.calibrate_depth)
-      calibrate_camera(corners.board, corners.depth, depth_size, rig.depth);
-    calibrate_camera(corners.board, corners.color, color_size, rig.color);
-    rig.depth.width = depth_size.width;
-    rig.depth.height = depth_size.height;
-
-    // The transform with both cameras' intrinsics fixed; then, when both were calibrated
-    // here, everything refined together: the colour camera's sharper corners pin the
-    // board poses that the ToF camera's focal length and principal point depend on (on
-    // rendered views this halves their error, and T's with them).
-    cv::Mat depth_matrix(rig.depth.camera_matrix());
-    cv::Mat color_matrix(rig.color.camera_matrix());
-    cv::Mat depth_distortion(cv::Matx<double, 1, 5>(rig.depth.distortion.data()));
-    cv::Mat color_distortion(cv::Matx<double, 1, 5>(rig.color.distortion.data()));
-    cv::Mat rotation;
-    cv::Mat translation;
-    cv::Mat stereo_errors;
-    result.stereo_rms_px = cv::stereoCalibrate(
-        corners.board, corners.depth, corners.color, depth_matrix, depth_distortion, color_matrix,
-        color_distortion, depth_size, rotation, translation, cv::noArray(), cv::noArray(),
-        stereo_errors, cv::CALIB_FIX_INTRINSIC);
-    if (options.calibrate_depth) {
-      result.stereo_rms_px = cv::stereoCalibrate(
-          corners.board, corners.depth, corners.color, depth_matrix, depth_distortion, color_matrix,
-          color_distortion, depth_size, rotation, translation, cv::noArray(), cv::noArray(),
-          stereo_errors, cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_USE_EXTRINSIC_GUESS);
-      set_intrinsics(rig.depth, depth_size, depth_matrix, depth_distortion);
-      set_intrinsics(rig.color, color_size, color_matrix, color_distortion);
-    }
-    rig.depth_to_color_r = cv::Matx33d(rotation.ptr<double>());
-    rig.depth_to_color_t_mm = cv::Vec3d(translation.ptr<double>());
-
+    const Solution solution =
+        solve_once(corners, rig, depth_size, color_size, options.calibrate_depth);
     std::vector<double> worst(used.size());
     std::vector<double> depth_errors(used.size());
     std::vector<double> color_errors(used.size());
     for (std::size_t i = 0; i < used.size(); ++i) {
       ViewResult& view = result.views[used[i]];
-      view.depth_rms_px = stereo_errors.at<double>(static_cast<int>(i), 0);
-      view.color_rms_px = stereo_errors.at<double>(static_cast<int>(i), 1);
+      view.depth_rms_px = depth_errors[i] = solution.view_errors.at<double>(static_cast<int>(i), 0);
+      view.color_rms_px = color_errors[i] = solution.view_errors.at<double>(static_cast<int>(i), 1);
       worst[i] = std::max(view.depth_rms_px, view.color_rms_px);
-      depth_errors[i] = view.depth_rms_px;
-      color_errors[i] = view.color_rms_px;
     }
-    result.depth_rms_px = rms_of(depth_errors);
-    result.color_rms_px = rms_of(color_errors);
     // The worst view alone, then solve again: one bad view inflates the others' errors
     // (and the median) until it is gone.
     const double limit = std::max(kRejectFactor * median(worst), kRejectFloorPx);
     const auto worst_view = std::max_element(worst.begin(), worst.end()) - worst.begin();
     if (worst[worst_view] <= limit) {
+      result.rig = solution.rig;
+      result.depth_rms_px = rms_of(depth_errors);
+      result.color_rms_px = rms_of(color_errors);
+      result.stereo_rms_px = solution.stereo_rms_px;
       result.used = std::move(corners);
       break;
     }
     ViewResult& view = result.views[used[worst_view]];
     char reason[160];
     std::snprintf(reason, sizeof reason,
-                  "rejected: RMS %.3f px (intensity), %.3f px (colour), above %.3f px (%.0f "
-                  "times the median view's, at least %.1f px)",
+                  "RMS %.3f px (intensity), %.3f px (colour), above %.3f px (%.0f times the "
+                  "median view's, at least %.1f px)",
                   view.depth_rms_px, view.color_rms_px, limit, kRejectFactor, kRejectFloorPx);
     view.rejected = reason;
-    log << view.name << ": " << reason << "\n";
+    log << view.name << ": rejected: " << reason << "\n";
     used.erase(used.begin() + worst_view);
   }
-  result.rig = rig;
-  result.uncertainty = extrinsic_uncertainty(result.used, rig, options.calibrate_depth);
+  result.uncertainty = extrinsic_uncertainty(result.used, result.rig, options.calibrate_depth);
   return result;
 }
 

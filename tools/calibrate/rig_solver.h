@@ -51,7 +51,7 @@ struct SolveResult {
 // options.calibrate_depth). Prints each rejected view and why to `log`. Throws
 // tilth::Error when no view shows the board in both images, when fewer than kMinViews
 // remain, or when the views' image sizes differ from each other or from `rig`'s.
-SolveResult solve_rig(const std::vector<BoardView>& views, RigCalibration rig,
+SolveResult solve_rig(const std::vector<BoardView>& views, const RigCalibration& rig,
                       const SolveOptions& options, std::ostream& log);
 
 }  // namespace tilth::calibrate
