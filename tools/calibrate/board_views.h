@@ -42,6 +42,11 @@ struct BoardView {
 // intensity: 1 channel, 8 or 16 bits; the colour: 8 bits, 1 channel or 3 (BGR)).
 BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic mosaic);
 
+// find_board of every view, on all cores (a second or two per colour image); throws the
+// error of the first view that has one.
+std::vector<BoardView> find_boards(const std::vector<ViewFiles>& views, cv::Size inner_corners,
+                                   ColorMosaic mosaic);
+
 // The ToF intensity scaled to 8 bits: its 1st percentile to 0 and its 99th to 255, so
 // the board's contrast fills the range whatever the exposure.
 cv::Mat intensity_to_8bit(const cv::Mat& intensity);

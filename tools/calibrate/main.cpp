@@ -9,6 +9,8 @@
 #include <set>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "basler_import.h"
 #include "board_views.h"
 #include "command_line.h"
@@ -143,6 +145,17 @@ void apply_depth_camera(const std::string& text, tilth::CameraIntrinsics& camera
   camera.distortion = {};
 }
 
+// The report's coverage grids side by side: where the board has not been yet.
+void print_coverage(const nlohmann::json& coverage) {
+  const auto& depth = coverage.at("depth").at("cells");
+  const auto& color = coverage.at("color").at("cells");
+  std::cout << "board coverage (# a corner in the cell)\n  ToF       colour\n";
+  for (std::size_t row = 0; row < depth.size(); ++row) {
+    std::cout << "  " << depth[row].get<std::string>() << "  " << color[row].get<std::string>()
+              << "\n";
+  }
+}
+
 fs::path default_report(const fs::path& calibration) {
   std::string name = calibration.string();
   const std::string suffix = ".calib.json";
@@ -192,16 +205,15 @@ int solve(const CommandLine& line) {
                           : tilth::calibrate::ColorMosaic::kNone;
 
   std::vector<fs::path> folders(line.positional().begin() + 1, line.positional().end());
-  std::vector<tilth::calibrate::BoardView> views;
-  for (const auto& files : tilth::calibrate::find_views(folders)) {
-    views.push_back(tilth::calibrate::find_board(files, options.inner_corners, mosaic));
-  }
+  const auto views = tilth::calibrate::find_boards(tilth::calibrate::find_views(folders),
+                                                   options.inner_corners, mosaic);
   const auto result = tilth::calibrate::solve_rig(views, rig, options, std::cout);
   const std::string calibration_text = checked_calibration_text(result.rig, calibration);
-  const std::string report_text =
-      tilth::calibrate::solve_report(result, options, calibration.string()).dump(2) + "\n";
+  const nlohmann::json report_document =
+      tilth::calibrate::solve_report(result, options, calibration.string());
   write_file(calibration, calibration_text);
-  write_file(report, report_text);
+  write_file(report, report_document.dump(2) + "\n");
+  print_coverage(report_document.at("coverage"));
   const auto& u = result.uncertainty;
   std::cout << calibration.string() << ": " << result.used.board.size() << " of " << views.size()
             << " views; RMS " << result.depth_rms_px << " px (ToF), " << result.color_rms_px
