@@ -9,6 +9,12 @@
 namespace tilth::calibrate {
 namespace {
 
+// OpenCV's parse errors put the file, the line and the reason in cv::Exception::func and
+// the parser's function in err (4.6; other versions swap them): both, whichever is where.
+std::string opencv_message(const cv::Exception& error) {
+  return error.func.empty() ? error.err : error.err + ": " + error.func;
+}
+
 class BaslerFile {
  public:
   explicit BaslerFile(const std::filesystem::path& file) : name_(file.string()) {
@@ -17,7 +23,7 @@ class BaslerFile {
         throw Error(name_ + ": cannot open Basler calibration file");
       }
     } catch (const cv::Exception& error) {
-      throw Error(name_ + ": not an OpenCV FileStorage file: " + error.err);
+      throw Error(name_ + ": not an OpenCV FileStorage file: " + opencv_message(error));
     }
   }
 
@@ -29,7 +35,8 @@ class BaslerFile {
     try {
       node >> value;
     } catch (const cv::Exception& error) {
-      fail(node_name, "expected " + what + " (an opencv-matrix), got something else: " + error.err);
+      fail(node_name, "expected " + what +
+                          " (an opencv-matrix), got something else: " + opencv_message(error));
     }
     if (value.empty() || value.channels() != 1) {
       fail(node_name, "expected " + what + " (an opencv-matrix)");
