@@ -35,10 +35,12 @@ void check_sizes(const std::vector<BoardView>& views, const RigCalibration& rig,
   const cv::Size depth(rig.depth.width, rig.depth.height);
   const cv::Size color(rig.color.width, rig.color.height);
   if (first.depth_size != depth || first.color_size != color) {
-    throw Error("the views' images are " + size_text(first.depth_size) + " (intensity) and " +
-                size_text(first.color_size) + " (colour), " + rig.origin + "'s cameras " +
-                size_text(depth) + " and " + size_text(color) +
-                "; expected images of the calibration's cameras");
+    throw Error(
+        "the views' images are " + size_text(first.depth_size) + " (intensity) and " +
+        size_text(first.color_size) + " (colour), " +
+        (rig.origin.empty() ? "--depth-size and --color-size say" : rig.origin + "'s cameras") +
+        " " + size_text(depth) + " and " + size_text(color) +
+        "; expected images of the calibration's cameras");
   }
 }
 
