@@ -1,0 +1,54 @@
+// The calibration views of `tilth calibrate solve`: pairs of a ToF intensity image and a
+// colour image of the same board pose, found by name in folders, and the board's inner
+// corners found in each image.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/types.hpp>
+
+namespace tilth::calibrate {
+
+// Where a view's two images are: FOLDER/NAME_intensity.png and FOLDER/NAME_color.png.
+struct ViewFiles {
+  std::string name;  // FOLDER/NAME, as messages and the report name the view
+  std::filesystem::path intensity;
+  std::filesystem::path color;
+};
+
+// Every pair in each folder, sorted by name. Throws tilth::Error for a path that is not a
+// folder, a folder without pairs, and an image whose partner is missing.
+std::vector<ViewFiles> find_views(const std::vector<std::filesystem::path>& folders);
+
+// How the colour camera's 1-channel images are to be read: as grey, or as a Bayer mosaic
+// named by its first row's first two pixels (GenICam's BayerRG8 is kRg: R G / G B).
+enum class ColorMosaic { kNone, kRg, kBg, kGr, kGb };
+
+// "RG" -> kRg; throws tilth::Error for another text.
+ColorMosaic parse_color_mosaic(const std::string& text);
+
+struct BoardView {
+  std::string name;
+  cv::Size depth_size;
+  cv::Size color_size;
+  std::vector<cv::Point2f> depth_corners;  // empty when the board was not found
+  std::vector<cv::Point2f> color_corners;
+};
+
+// The images read and the board's `inner_corners` (columns x rows) found in each. Throws
+// tilth::Error naming the file when an image cannot be read or has the wrong type (the
+// intensity: 1 channel, 8 or 16 bits; the colour: 8 bits, 1 channel or 3 (BGR)).
+BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic mosaic);
+
+// find_board of every view, on all cores (a second or two per colour image); throws the
+// error of the first view that has one.
+std::vector<BoardView> find_boards(const std::vector<ViewFiles>& views, cv::Size inner_corners,
+                                   ColorMosaic mosaic);
+
+// The ToF intensity scaled to 8 bits: its 1st percentile to 0 and its 99th to 255, so
+// the board's contrast fills the range whatever the exposure.
+cv::Mat intensity_to_8bit(const cv::Mat& intensity);
+
+}  // namespace tilth::calibrate

@@ -1,0 +1,75 @@
+#include "rig_facts.h"
+
+#include <charconv>
+#include <optional>
+
+#include "tilth/error.h"
+
+namespace tilth::calibrate {
+namespace {
+
+// "640x480" -> {640, 480}.
+std::optional<std::pair<int, int>> parse_size(const std::string& text) {
+  const auto x = text.find('x');
+  if (x == std::string::npos) return std::nullopt;
+  int width = 0;
+  int height = 0;
+  const char* end = text.data() + text.size();
+  const auto [width_end, width_error] = std::from_chars(text.data(), text.data() + x, width);
+  const auto [height_end, height_error] = std::from_chars(text.data() + x + 1, end, height);
+  if (width_error != std::errc() || width_end != text.data() + x || height_error != std::errc() ||
+      height_end != end || width <= 0 || height <= 0) {
+    return std::nullopt;
+  }
+  return std::make_pair(width, height);
+}
+
+void apply_size(const cli::CommandLine& line, const std::string& option, CameraIntrinsics& camera) {
+  const auto text = line.value(option);
+  if (!text) return;
+  const auto size = parse_size(*text);
+  if (!size)
+    throw Error(option + ": expected WIDTHxHEIGHT in pixels, e.g. 640x480, got '" + *text + "'");
+  camera.width = size->first;
+  camera.height = size->second;
+}
+
+[[noreturn]] void missing(const std::string& what) {
+  throw Error("missing " + what + ": give it, or --base RIG.calib.json whose value is kept");
+}
+
+}  // namespace
+
+RigCalibration rig_facts(const cli::CommandLine& line, bool need_sizes) {
+  const auto base = line.value("--base");
+  RigCalibration rig = base ? load_calibration(*base) : RigCalibration{};
+  if (const auto model = line.value("--depth-model")) rig.depth.model = *model;
+  if (const auto model = line.value("--color-model")) rig.color.model = *model;
+  if (const auto measure = line.value("--depth-measure")) {
+    if (*measure == "radial") {
+      rig.depth.depth_measure = DepthMeasure::kRadial;
+    } else if (*measure == "z") {
+      rig.depth.depth_measure = DepthMeasure::kZ;
+    } else {
+      throw Error("--depth-measure: expected radial or z, got '" + *measure + "'");
+    }
+  }
+  // The bounds of docs/formats/calibration.md; the written file is validated in full.
+  if (const auto value = line.real("--gray-to-mm", 1e-9, 2.0)) rig.depth.gray_to_mm = *value;
+  if (const auto value = line.real("--gray-offset-mm", -200.0, 200.0)) {
+    rig.depth.gray_offset_mm = *value;
+  }
+  if (const auto value = line.real("--z-offset-mm", -200.0, 200.0)) rig.depth.z_offset_mm = *value;
+  apply_size(line, "--depth-size", rig.depth);
+  apply_size(line, "--color-size", rig.color);
+  if (base) return rig;
+  if (!line.value("--gray-to-mm")) missing("--gray-to-mm (the ToF camera's Scan3dCoordinateScale)");
+  if (!line.value("--z-offset-mm")) {
+    missing("--z-offset-mm (the ToF optical centre behind the mounting surface)");
+  }
+  if (need_sizes && !line.value("--depth-size")) missing("--depth-size WIDTHxHEIGHT");
+  if (need_sizes && !line.value("--color-size")) missing("--color-size WIDTHxHEIGHT");
+  return rig;
+}
+
+}  // namespace tilth::calibrate
