@@ -6,6 +6,7 @@ same values the CSV has for the frame the frame counter names.
 """
 import csv
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -56,6 +57,7 @@ class MachineGraphs(unittest.TestCase):
         """Runs the simulated machine graph while polling `port` (Tilth's server or the
         stand-in PLC); returns the CSV rows and the register blocks read."""
         tmp = tempfile.mkdtemp(prefix="tilth-%s-" % machine)
+        self.addCleanup(shutil.rmtree, tmp, ignore_errors=True)
         log = os.path.join(tmp, machine + ".csv")
         command = [TILTH, "run", os.path.join(GRAPHS, "simulated", machine + ".json"), "--quiet",
                    "--var", "log=" + log, "--set", "camera.frames=%d" % FRAMES,

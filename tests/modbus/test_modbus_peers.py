@@ -88,8 +88,14 @@ class TilthRun:
         return self.wait()
 
     def wait(self):
-        """Until it exits by itself; returns the exit code and what was logged."""
-        code = self.process.wait(timeout=20)
+        """Until it exits by itself; returns the exit code and what was logged. A run that
+        has not exited in 20 s is killed, and the timeout raised."""
+        try:
+            code = self.process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+            raise
         self.stderr_file.close()
         with open(self.stderr_path) as f:
             return code, f.read()
