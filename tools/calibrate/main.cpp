@@ -323,9 +323,14 @@ int check(const CommandLine& line) {
   const std::string recording = line.positional()[1];
   calibrate::ReplayOptions replay;
   if (const auto file = line.value("--calibration")) replay.calibration = *file;
-  replay.max_frames = line.count("--frames", 1, 100000).value_or(kDefaultCheckFrames);
-  const double max_offset_px = line.real("--max-offset-px", 0.0, calibrate::kSearchRadiusPx)
-                                   .value_or(calibrate::kDefaultMaxOffsetPx);
+  double max_offset_px = calibrate::kDefaultMaxOffsetPx;
+  try {
+    replay.max_frames = line.count("--frames", 1, 100000).value_or(kDefaultCheckFrames);
+    max_offset_px =
+        line.real("--max-offset-px", 0.0, calibrate::kSearchRadiusPx).value_or(max_offset_px);
+  } catch (const Error& error) {
+    return usage_error(error.what());
+  }
   const auto overlay = line.value("--overlay");
   const auto report = line.value("--report");
   if (overlay && fs::path(*overlay).extension() != ".png") {
