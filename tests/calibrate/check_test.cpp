@@ -88,11 +88,9 @@ TEST_F(CalibrateCheck, TheRecordingsOwnCalibrationHolds) {
   const auto& overall = report.at("overall");
   EXPECT_GT(overall.at("depth_edge_pixels").get<int>(), 30000);
   EXPECT_EQ(report.at("frames").size(), 3u);
-  // Measured (0.68, -0.16) px: along the baseline the colour edges of straw stacked on
-  // straw lie beyond the depth edges where the colour camera sees the upper straw in
-  // front of soil the ToF camera sees (the registration gives those pixels the straw's
-  // colour), up to fx_d * 45 mm * (1/Z_near - 1/Z_far): 0.8 px for 10 mm of height.
-  // A correct rig stays under 1 px, two thirds of the default threshold.
+  // Measured (0.68, -0.16) px; 0.57 to 0.80 px over the simulator's straw presets, a
+  // bias of the method (docs/calibration.md, "The threshold"): a correct rig stays
+  // under 1 px, two thirds of the default threshold.
   EXPECT_LT(std::hypot(offset(report).x, offset(report).y), 1.0);
   EXPECT_LT(report.at("offset_spread_px").get<double>(), 0.2);
   EXPECT_LE(overall.at("distance_at_zero").at("median_px").get<double>(), 1.5);

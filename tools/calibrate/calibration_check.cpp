@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "edge_maps.h"
@@ -27,7 +28,8 @@ AlignmentSummary summarise(const ShiftedDistances& distances, NearSide side) {
         << " of each needed: too few edges to go by (bare soil? the colour dark, overexposed "
            "or out of focus?)";
   } else if (summary.contrast < kMinContrast) {
-    why << "no shift matches the edges distinctly better than the others (contrast "
+    why << std::fixed << std::setprecision(2)
+        << "no shift matches the edges distinctly better than the others (contrast "
         << summary.contrast << ", " << kMinContrast << " needed)";
   }
   summary.cannot_judge = why.str();
@@ -110,8 +112,9 @@ CheckResult check_calibration(const std::filesystem::path& recording, const Repl
   result.spread_px = std::sqrt(squares / static_cast<double>(judged));
   const double offset = std::hypot(result.overall.offset_px.x, result.overall.offset_px.y);
   std::ostringstream reason;
-  reason << "the colour lies " << offset << " px from the depth (" << judged << " of "
-         << result.frames.size() << " frames judged); at most " << max_offset_px << " px holds";
+  reason << std::fixed << std::setprecision(2) << "the colour lies " << offset
+         << " px from the depth (" << judged << " of " << result.frames.size()
+         << " frames judged); at most " << max_offset_px << " px holds";
   result.reason = reason.str();
   result.verdict = offset > max_offset_px ? Verdict::kRecalibrate : Verdict::kHolds;
   return result;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <set>
@@ -295,6 +296,9 @@ void print_check(const tilth::calibrate::CheckResult& result, const std::string&
   const auto& o = result.overall;
   std::size_t judged = 0;
   for (const auto& frame : result.frames) judged += frame.summary.cannot_judge.empty();
+  const auto old_flags = std::cout.flags();
+  const auto old_precision = std::cout.precision(2);
+  std::cout << std::fixed;
   std::cout << recording << ": " << judged << " of " << result.frames.size() << " frames judged, "
             << o.depth_edge_pixels << " depth edge pixels, " << o.color_edge_pixels
             << " colour edge pixels\n";
@@ -311,6 +315,8 @@ void print_check(const tilth::calibrate::CheckResult& result, const std::string&
   if (result.verdict == Verdict::kRecalibrate) {
     std::cout << "  recalibrate the rig (docs/calibration.md, \"Checking a rig in the field\")\n";
   }
+  std::cout.flags(old_flags);
+  std::cout.precision(old_precision);
 }
 
 int check(const CommandLine& line) {
@@ -348,9 +354,9 @@ int check(const CommandLine& line) {
   }
   if (overlay) {
     std::ostringstream caption;
-    caption << "frame " << result.overlay_frame_id << ": " << to_string(result.verdict)
-            << ", offset (" << result.overall.offset_px.x << ", " << result.overall.offset_px.y
-            << ") px; magenta depth edges, green colour edges";
+    caption << std::fixed << std::setprecision(2) << "frame " << result.overlay_frame_id << ": "
+            << to_string(result.verdict) << ", offset (" << result.overall.offset_px.x << ", "
+            << result.overall.offset_px.y << ") px; magenta depth edges, green colour edges";
     std::vector<std::uint8_t> png;
     cv::imencode(".png",
                  calibrate::alignment_overlay(result.overlay_bgr, result.overlay_depth_edges,
