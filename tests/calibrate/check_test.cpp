@@ -28,6 +28,16 @@ constexpr double kDepthFxPx = 509.935;
 // Soil at 518 mm from the mounting surface, 23.97 mm in front of the ToF optical centre.
 constexpr double kSoilFromOpticalCentreMm = 518.0 + 23.97;
 
+// The paper rig with the colour camera turned `degrees` about its y axis.
+fs::path turned_rig(const TempDir& dir, double degrees) {
+  const double angle = degrees * std::numbers::pi / 180.0;
+  nlohmann::json rig = paper_rig_document();
+  rig["depth_to_color"]["R"] = {{std::cos(angle), 0.0, std::sin(angle)},
+                                {0.0, 1.0, 0.0},
+                                {-std::sin(angle), 0.0, std::cos(angle)}};
+  return dir.write("turned.calib.json", rig.dump(2));
+}
+
 class CalibrateCheck : public ::testing::Test {
  protected:
   // One straw recording (case_c: straw on straw, stubble, shadows) and one of bare soil
@@ -105,11 +115,7 @@ TEST_F(CalibrateCheck, ARigTurnedHalfADegreeSaysRecalibrate) {
   // colour pixels further right, so each depth pixel gets the colour of a point that far
   // right, and the registered colour moves left by fx_d * angle = 4.45 depth pixels.
   const double angle = 0.5 * std::numbers::pi / 180.0;
-  const fs::path knocked = knocked_rig([&](nlohmann::json& rig) {
-    rig["depth_to_color"]["R"] = {{std::cos(angle), 0.0, std::sin(angle)},
-                                  {0.0, 1.0, 0.0},
-                                  {-std::sin(angle), 0.0, std::cos(angle)}};
-  });
+  const fs::path knocked = turned_rig(own_, 0.5);
   const auto report =
       check(recording("straw").string() + " --calibration " + knocked.string(), kRecalibrate);
   ASSERT_FALSE(report.is_null() || own.is_null()) << output_;
@@ -123,6 +129,17 @@ TEST_F(CalibrateCheck, ARigTurnedHalfADegreeSaysRecalibrate) {
   EXPECT_NEAR(moved.x, -kDepthFxPx * angle, 0.6);
   EXPECT_NEAR(moved.y, 0.0, 0.3);
   EXPECT_EQ(report.at("calibration"), knocked.string());
+}
+
+TEST_F(CalibrateCheck, ARigTurnedTwoDegreesIsStillFound) {
+  const auto own = check(recording("straw").string(), 0);
+  // 17.8 px, within the 20 px searched. Measured -18.17 px.
+  const auto report =
+      check(recording("straw").string() + " --calibration " + turned_rig(own_, 2.0).string(),
+            kRecalibrate);
+  ASSERT_FALSE(report.is_null() || own.is_null()) << output_;
+  const cv::Point2d moved = offset(report) - offset(own);
+  EXPECT_NEAR(moved.x, -kDepthFxPx * 2.0 * std::numbers::pi / 180.0, 0.6);
 }
 
 TEST_F(CalibrateCheck, ATranslationOff5MillimetresSaysRecalibrate) {

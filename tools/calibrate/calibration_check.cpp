@@ -30,7 +30,8 @@ AlignmentSummary summarise(const ShiftedDistances& distances, NearSide side) {
   } else if (summary.contrast < kMinContrast) {
     why << std::fixed << std::setprecision(2)
         << "no shift matches the edges distinctly better than the others (contrast "
-        << summary.contrast << ", " << kMinContrast << " needed)";
+        << summary.contrast << ", " << kMinContrast << " needed); a rig knocked further than the "
+        << kSearchRadiusPx << " px searched looks like this too: see the overlay";
   }
   summary.cannot_judge = why.str();
   return summary;

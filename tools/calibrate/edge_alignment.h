@@ -15,8 +15,9 @@
 namespace tilth::calibrate {
 
 // Shifts searched, in depth pixels each way: a rig knocked by 1 degree (fx 510) is 9 px
-// off. A best shift on the window's rim means "at least this far off".
-constexpr int kSearchRadiusPx = 12;
+// off, 2 degrees 18 px. A best shift on the window's rim means "at least this far off";
+// beyond it no shift matches and the check cannot judge.
+constexpr int kSearchRadiusPx = 20;
 
 // Distances beyond this are a depth edge without a colour edge of its own (soil clods
 // the colour of the soil, a straw on a straw) or paired with another's; capped, they

@@ -34,9 +34,9 @@ class InProcessGraph {
   void add_stage_type(StageDescriptor descriptor);
 
   // Loads the plugins, validates (throws GraphError with every problem), makes the stages
-  // (throws tilth::Error naming each that failed to start) and runs until the sources end
-  // or a stop signal stops it as it stops `tilth run` (RunResult::stopped; the program
-  // calls install_stop_handlers first).
+  // (throws tilth::Error naming each that failed to start) and runs until the sources end,
+  // `limits` are reached, or a stop signal stops it as it stops `tilth run` (RunResult::stopped;
+  // the program calls install_stop_handlers first).
   RunResult run(RunLimits limits = {}) const;
 
  private:
