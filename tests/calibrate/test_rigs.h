@@ -83,10 +83,10 @@ struct ToolRun {
   std::string output;  // stdout and stderr
 };
 
-// tilth-calibrate ARGS, the program the build made (TILTH_CALIBRATE: its path).
-inline ToolRun run_calibrate(const std::string& args) {
+// PROGRAM ARGS through the shell.
+inline ToolRun run_program(const std::string& program, const std::string& args) {
   ToolRun run;
-  FILE* pipe = popen((std::string(TILTH_CALIBRATE) + " " + args + " 2>&1").c_str(), "r");
+  FILE* pipe = popen((program + " " + args + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return run;
   std::array<char, 4096> buffer{};
   while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) run.output += buffer.data();
@@ -94,5 +94,8 @@ inline ToolRun run_calibrate(const std::string& args) {
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
 }
+
+// tilth-calibrate ARGS, the program the build made (TILTH_CALIBRATE: its path).
+inline ToolRun run_calibrate(const std::string& args) { return run_program(TILTH_CALIBRATE, args); }
 
 }  // namespace tilth::testing

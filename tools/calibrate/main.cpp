@@ -1,18 +1,26 @@
 // `tilth calibrate` (the tilth-calibrate program): a rig calibration file
 // (tilth-calibration/1) solved from checkerboard views of both cameras, or imported from
-// Basler's blaze + ace calibration result. docs/calibration.md is the user's guide.
+// Basler's blaze + ace calibration result, and checked in the field on a recording.
+// docs/calibration.md is the user's guide.
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
+#include "alignment_overlay.h"
 #include "basler_import.h"
 #include "board_views.h"
+#include "calibration_check.h"
+#include "check_report.h"
 #include "command_line.h"
 #include "commands.h"
 #include "rig_facts.h"
@@ -51,7 +59,25 @@ constexpr const char* kUsage = R"(usage: tilth calibrate COMMAND ARGS
       as a rig calibration. The file holds no image sizes: give --depth-size and
       --color-size, or --base.
 
-What neither the views nor Basler's file say (both commands):
+  check RECORDING
+      Whether a calibration still registers the colour onto the depth: on the
+      frames of an image-folder recording, how far the depth edges (straw, stubble,
+      the board's edges) lie from the colour edges after registration, and the
+      shift that brings them together.
+        --calibration RIG.calib.json
+                        check this calibration on the recording's frames instead
+                        of the recording's own
+        --frames N      the first N frames (default 30)
+        --max-offset-px P
+                        the largest offset, in depth pixels, that still holds
+                        (default 1.5: the residue mask's 2 px dilation covers it)
+        --overlay OUT.png
+                        the registered colour of the frame with the most depth
+                        edges, depth edges magenta, colour edges green
+        --report OUT.json
+                        per frame and overall: edges used, distances, offset, verdict
+
+What neither the views nor Basler's file say (solve and import):
   --base RIG.calib.json   a calibration of the same rig whose other fields are kept
   --gray-to-mm G          the ToF camera's Scan3dCoordinateScale (mm per gray value)
   --gray-offset-mm O      its Scan3dCoordinateOffset (default 0)
@@ -63,15 +89,23 @@ Without --base, --gray-to-mm and --z-offset-mm are required.
 
   --overwrite             replace existing output files
 
-Nothing is written when anything fails. Exit code 0 on success, 1 when the input
-cannot be read or solved, 2 for bad usage.
+Nothing is written when anything fails. Exit code 0 on success (check: the
+calibration holds), 1 when the input cannot be read or solved, 2 for bad usage;
+check: 4 when it says recalibrate, 5 when the frames cannot tell (too few edges).
 )";
 
+constexpr int kExitRecalibrate = 4;
+constexpr int kExitCannotJudge = 5;
+constexpr std::uint64_t kDefaultCheckFrames = 30;
+
+const std::set<std::string> kCheckOptions = {"--calibration", "--frames", "--max-offset-px",
+                                             "--overlay"};
+
 const std::set<std::string> kValued = {
-    "--out",           "--board",      "--square-mm",      "--depth-intrinsics", "--depth-camera",
-    "--color-bayer",   "--report",     "--base",           "--depth-model",      "--color-model",
-    "--depth-measure", "--gray-to-mm", "--gray-offset-mm", "--z-offset-mm",      "--depth-size",
-    "--color-size"};
+    "--out",           "--board",       "--square-mm",      "--depth-intrinsics", "--depth-camera",
+    "--color-bayer",   "--report",      "--base",           "--depth-model",      "--color-model",
+    "--depth-measure", "--gray-to-mm",  "--gray-offset-mm", "--z-offset-mm",      "--depth-size",
+    "--color-size",    "--calibration", "--frames",         "--max-offset-px",    "--overlay"};
 
 int usage_error(const std::string& message) {
   std::cerr << "tilth calibrate: " << message << "\n\n" << kUsage;
@@ -167,6 +201,15 @@ fs::path default_report(const fs::path& calibration) {
   return name + ".report.json";
 }
 
+// A command refuses the options of another, rather than ignore them.
+std::optional<std::string> foreign_option(const CommandLine& line,
+                                          const std::set<std::string>& own) {
+  for (const std::string& option : kValued) {
+    if (!own.count(option) && line.value(option)) return option;
+  }
+  return std::nullopt;
+}
+
 int solve(const CommandLine& line) {
   const auto out = line.value("--out");
   const auto board_text = line.value("--board");
@@ -174,6 +217,9 @@ int solve(const CommandLine& line) {
   if (line.positional().size() < 2) return usage_error("solve takes DIR... (folders of views)");
   if (!out || !board_text || !square_mm) {
     return usage_error("solve needs --board COLSxROWS, --square-mm S and --out RIG.calib.json");
+  }
+  for (const std::string& option : kCheckOptions) {
+    if (line.value(option)) return usage_error(option + " is a check option");
   }
   tilth::calibrate::SolveOptions options;
   options.inner_corners = parse_board(*board_text);
@@ -233,6 +279,9 @@ int import(const CommandLine& line) {
                              "--color-bayer", "--report"}) {
     if (line.value(option)) return usage_error(std::string(option) + " is a solve option");
   }
+  for (const std::string& option : kCheckOptions) {
+    if (line.value(option)) return usage_error(option + " is a check option");
+  }
   const fs::path calibration = *out;
   check_output(calibration, line.flag("--overwrite"));
   const RigCalibration rig = tilth::calibrate::import_basler(
@@ -240,6 +289,91 @@ int import(const CommandLine& line) {
   write_file(calibration, checked_calibration_text(rig, calibration));
   std::cout << calibration.string() << ": imported from " << line.positional()[1] << "\n";
   return kExitOk;
+}
+
+void print_check(const tilth::calibrate::CheckResult& result, const std::string& recording) {
+  using tilth::calibrate::Verdict;
+  const auto& o = result.overall;
+  std::size_t judged = 0;
+  for (const auto& frame : result.frames) judged += frame.summary.cannot_judge.empty();
+  const auto old_flags = std::cout.flags();
+  const auto old_precision = std::cout.precision(2);
+  std::cout << std::fixed;
+  std::cout << recording << ": " << judged << " of " << result.frames.size() << " frames judged, "
+            << o.depth_edge_pixels << " depth edge pixels, " << o.color_edge_pixels
+            << " colour edge pixels\n";
+  if (result.verdict != Verdict::kCannotJudge) {
+    std::cout << "  depth edge to nearest colour edge: median " << o.at_zero.median_px
+              << " px, 90% " << o.at_zero.p90_px << " px as registered; median "
+              << o.at_best.median_px << " px, 90% " << o.at_best.p90_px << " px shifted by ("
+              << o.best_shift.x << ", " << o.best_shift.y << ")\n"
+              << "  offset (" << o.offset_px.x << ", " << o.offset_px.y << ") px, "
+              << std::hypot(o.offset_px.x, o.offset_px.y) << " px long; spread " << result.spread_px
+              << " px between frames\n";
+  }
+  std::cout << to_string(result.verdict) << ": " << result.reason << "\n";
+  if (result.verdict == Verdict::kRecalibrate) {
+    std::cout << "  recalibrate the rig (docs/calibration.md, \"Checking a rig in the field\")\n";
+  }
+  std::cout.flags(old_flags);
+  std::cout.precision(old_precision);
+}
+
+int check(const CommandLine& line) {
+  namespace calibrate = tilth::calibrate;
+  if (line.positional().size() != 2) return usage_error("check takes RECORDING (an image folder)");
+  if (const auto option = foreign_option(
+          line, {"--calibration", "--frames", "--max-offset-px", "--overlay", "--report"})) {
+    return usage_error(*option + " is not a check option");
+  }
+  const std::string recording = line.positional()[1];
+  calibrate::ReplayOptions replay;
+  if (const auto file = line.value("--calibration")) replay.calibration = *file;
+  double max_offset_px = calibrate::kDefaultMaxOffsetPx;
+  try {
+    replay.max_frames = line.count("--frames", 1, 100000).value_or(kDefaultCheckFrames);
+    max_offset_px =
+        line.real("--max-offset-px", 0.0, calibrate::kSearchRadiusPx).value_or(max_offset_px);
+  } catch (const Error& error) {
+    return usage_error(error.what());
+  }
+  const auto overlay = line.value("--overlay");
+  const auto report = line.value("--report");
+  if (overlay && fs::path(*overlay).extension() != ".png") {
+    return usage_error("--overlay: expected a file name ending in .png, got '" + *overlay + "'");
+  }
+  if (overlay) check_output(*overlay, line.flag("--overwrite"));
+  if (report) check_output(*report, line.flag("--overwrite"));
+
+  const calibrate::CheckResult result =
+      calibrate::check_calibration(recording, replay, max_offset_px);
+  if (report) {
+    const nlohmann::json document =
+        calibrate::check_report(result, recording, replay.calibration.value_or("").string());
+    write_file(*report, document.dump(2) + "\n");
+  }
+  if (overlay) {
+    std::ostringstream caption;
+    caption << std::fixed << std::setprecision(2) << "frame " << result.overlay_frame_id << ": "
+            << to_string(result.verdict) << ", offset (" << result.overall.offset_px.x << ", "
+            << result.overall.offset_px.y << ") px; magenta depth edges, green colour edges";
+    std::vector<std::uint8_t> png;
+    cv::imencode(".png",
+                 calibrate::alignment_overlay(result.overlay_bgr, result.overlay_depth_edges,
+                                              result.overlay_color_edges, caption.str()),
+                 png);
+    write_file(*overlay, std::string(png.begin(), png.end()));
+  }
+  print_check(result, recording);
+  switch (result.verdict) {
+    case calibrate::Verdict::kHolds:
+      return kExitOk;
+    case calibrate::Verdict::kRecalibrate:
+      return kExitRecalibrate;
+    case calibrate::Verdict::kCannotJudge:
+      return kExitCannotJudge;
+  }
+  return kExitFailed;
 }
 
 }  // namespace
@@ -256,11 +390,14 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return kExitOk;
   }
-  if (line.positional().empty()) return usage_error("expected a command: solve or import");
+  if (line.positional().empty()) {
+    return usage_error("expected a command: solve, import or check");
+  }
   const std::string& command = line.positional()[0];
   try {
     if (command == "solve") return solve(line);
     if (command == "import") return import(line);
+    if (command == "check") return check(line);
     return usage_error("unknown command '" + command + "'");
   } catch (const std::exception& error) {
     std::cerr << "tilth calibrate: " << error.what() << "\n";

@@ -53,9 +53,14 @@ void InProcessGraph::add_edge(const std::string& from, const std::string& to) {
       {from, to, Location{program_, "/edges/" + std::to_string(spec_.edges.size())}});
 }
 
-RunResult InProcessGraph::run() const {
+void InProcessGraph::add_stage_type(StageDescriptor descriptor) {
+  own_types_.push_back(std::move(descriptor));
+}
+
+RunResult InProcessGraph::run(RunLimits limits) const {
   const auto registry = load_plugins({});
-  Runtime runtime(validate_graph(spec_, *registry), *registry);
+  for (const StageDescriptor& descriptor : own_types_) registry->add(descriptor, program_);
+  Runtime runtime(validate_graph(spec_, *registry), *registry, limits);
   const StopSignalWatcher watcher(program_, [&runtime] { runtime.stop(); });
   return runtime.run();
 }

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "framework/graph_spec.h"
 #include "framework/runtime.h"
+#include "tilth/stage_descriptor.h"
 
 namespace tilth::tools {
 
@@ -27,18 +29,22 @@ class InProcessGraph {
                        const std::string& text);
   void add_edge(const std::string& from, const std::string& to);
   void set_runtime(RuntimeOptions options) { spec_.runtime = options; }
+  // A stage type compiled into the program (a sink that hands the frames to the tool),
+  // registered beside the plugins' when the graph runs.
+  void add_stage_type(StageDescriptor descriptor);
 
   // Loads the plugins, validates (throws GraphError with every problem), makes the stages
-  // (throws tilth::Error naming each that failed to start) and runs until the sources end
-  // or a stop signal stops it as it stops `tilth run` (RunResult::stopped; the program
-  // calls install_stop_handlers first).
-  RunResult run() const;
+  // (throws tilth::Error naming each that failed to start) and runs until the sources end,
+  // `limits` are reached, or a stop signal stops it as it stops `tilth run` (RunResult::stopped;
+  // the program calls install_stop_handlers first).
+  RunResult run(RunLimits limits = {}) const;
 
  private:
   NodeSpec& node(const std::string& name);
 
   const std::string program_;
   GraphSpec spec_;
+  std::vector<StageDescriptor> own_types_;
 };
 
 }  // namespace tilth::tools
