@@ -90,31 +90,6 @@ float corner_spacing(const std::vector<cv::Point2f>& corners, cv::Size inner_cor
   return spacing;
 }
 
-// The board's inner corners found (cv::findChessboardCornersSB) and refined
-// (cv::cornerSubPix in a window of 0.3 squares, 2 to 10 px either side). On rendered
-// views this is as accurate as the detector's own CALIB_CB_ACCURACY in colour images,
-// twice as accurate in ToF intensity images (0.07 against 0.15 px RMS), and 4 times
-// faster.
-std::vector<cv::Point2f> corners_of(const cv::Mat& gray, cv::Size inner_corners) {
-  std::vector<cv::Point2f> corners;
-  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE;
-  if (!cv::findChessboardCornersSB(gray, inner_corners, corners, flags) ||
-      !regular_grid(corners, inner_corners)) {
-    return {};
-  }
-  const int half_window = std::clamp(
-      static_cast<int>(std::lround(0.3 * corner_spacing(corners, inner_corners))), 2, 10);
-  cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3));
-  // The detector may start from either end of the board (a half turn leaves the grid of
-  // corners in place), and not always from the same end in both cameras' images: start
-  // from the end nearer the image's top left, the same end in two cameras that look the
-  // same way.
-  const cv::Point2f first_to_last = corners.back() - corners.front();
-  if (first_to_last.x + first_to_last.y < 0.0f) std::reverse(corners.begin(), corners.end());
-  return corners;
-}
-
 }  // namespace
 
 std::vector<ViewFiles> find_views(const std::vector<fs::path>& folders) {
@@ -153,6 +128,32 @@ std::vector<ViewFiles> find_views(const std::vector<fs::path>& folders) {
     views.insert(views.end(), found.begin(), found.end());
   }
   return views;
+}
+
+// cv::cornerSubPix refines the detector's corners in a window of 0.3 squares (2 to 10 px
+// either side). On rendered views this is as accurate as the detector's own
+// CALIB_CB_ACCURACY in colour images, twice as accurate in ToF intensity images (0.07
+// against 0.15 px RMS), and 4 times faster.
+std::vector<cv::Point2f> board_corners(const cv::Mat& gray, cv::Size inner_corners,
+                                       BoardSearch search) {
+  std::vector<cv::Point2f> corners;
+  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE |
+                    (search == BoardSearch::kThorough ? cv::CALIB_CB_EXHAUSTIVE : 0);
+  if (!cv::findChessboardCornersSB(gray, inner_corners, corners, flags) ||
+      !regular_grid(corners, inner_corners)) {
+    return {};
+  }
+  const int half_window = std::clamp(
+      static_cast<int>(std::lround(0.3 * corner_spacing(corners, inner_corners))), 2, 10);
+  cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3));
+  // The detector may start from either end of the board (a half turn leaves the grid of
+  // corners in place), and not always from the same end in both cameras' images: start
+  // from the end nearer the image's top left, the same end in two cameras that look the
+  // same way.
+  const cv::Point2f first_to_last = corners.back() - corners.front();
+  if (first_to_last.x + first_to_last.y < 0.0f) std::reverse(corners.begin(), corners.end());
+  return corners;
 }
 
 ColorMosaic parse_color_mosaic(const std::string& text) {
@@ -197,8 +198,10 @@ BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic
   view.name = files.name;
   view.depth_size = intensity.size();
   view.color_size = color.size();
-  view.depth_corners = corners_of(intensity_to_8bit(intensity), inner_corners);
-  view.color_corners = corners_of(color_to_gray(color, mosaic, files.color), inner_corners);
+  view.depth_corners =
+      board_corners(intensity_to_8bit(intensity), inner_corners, BoardSearch::kThorough);
+  view.color_corners = board_corners(color_to_gray(color, mosaic, files.color), inner_corners,
+                                     BoardSearch::kThorough);
   return view;
 }
 

@@ -29,6 +29,17 @@ enum class ColorMosaic { kNone, kRg, kBg, kGr, kGb };
 // "RG" -> kRg; throws tilth::Error for another text.
 ColorMosaic parse_color_mosaic(const std::string& text);
 
+// kThorough: an exhaustive search (the solve; a second or two for a 1280x1024 image);
+// kQuick: none (live capture; about 50 ms for 640x512), which misses more boards. Both
+// refine the corners to a tenth of a pixel or better.
+enum class BoardSearch { kThorough, kQuick };
+
+// The board's `inner_corners` (columns x rows) in an 8-bit grey image, row by row from the
+// end nearer the image's top left (cv::findChessboardCornersSB); empty when the board is
+// not found or the corners found do not form a smooth grid (a misdetection).
+std::vector<cv::Point2f> board_corners(const cv::Mat& gray, cv::Size inner_corners,
+                                       BoardSearch search);
+
 struct BoardView {
   std::string name;
   cv::Size depth_size;

@@ -87,12 +87,22 @@ CheckResult check_calibration(const std::filesystem::path& recording, const Repl
     }
     result.frames.push_back({frame.frame_id, summary});
   });
-  if (result.frames.empty()) throw Error(recording.string() + ": no frame could be registered");
+  if (result.frames.empty()) {
+    throw Error(recording.string() +
+                ": holds no frames (expected at least one depth and colour pair)");
+  }
 
-  std::size_t judged = 0;
-  for (const FrameAlignment& frame : result.frames) judged += frame.summary.cannot_judge.empty();
+  for (const FrameAlignment& frame : result.frames) {
+    result.judged_frames += frame.summary.cannot_judge.empty();
+  }
+  const std::size_t judged = result.judged_frames;
   if (judged == 0) {
-    result.overall = result.frames.front().summary;
+    // The edges of every frame, and the first frame's reason.
+    for (const FrameAlignment& frame : result.frames) {
+      result.overall.depth_edge_pixels += frame.summary.depth_edge_pixels;
+      result.overall.color_edge_pixels += frame.summary.color_edge_pixels;
+    }
+    result.overall.cannot_judge = result.frames.front().summary.cannot_judge;
     result.verdict = Verdict::kCannotJudge;
     result.reason = "no frame could be judged; the first: " + result.overall.cannot_judge;
     return result;

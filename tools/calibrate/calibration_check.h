@@ -48,6 +48,8 @@ struct FrameAlignment {
 
 struct CheckResult {
   std::vector<FrameAlignment> frames;
+  std::size_t judged_frames = 0;
+  // The judged frames pooled; with none judged, only the edge counts, of every frame.
   AlignmentSummary overall;
   // RMS distance of the judged frames' offsets from the overall offset.
   double spread_px = 0.0;

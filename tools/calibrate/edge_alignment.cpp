@@ -55,7 +55,7 @@ void ShiftedDistances::add_frame(const cv::Mat& depth_edges, const DirectedDista
   for (int dy = -kSearchRadiusPx; dy <= kSearchRadiusPx; ++dy) {
     for (int dx = -kSearchRadiusPx; dx <= kSearchRadiusPx; ++dx) {
       const std::size_t at = index({dx, dy});
-      std::uint32_t* bins = &histogram_[at * kBins];
+      std::uint64_t* bins = &histogram_[at * kBins];
       double sum = 0.0;
       std::uint64_t count = 0;
       for (std::size_t i = 0; i < edges.size(); ++i) {
@@ -65,7 +65,9 @@ void ShiftedDistances::add_frame(const cv::Mat& depth_edges, const DirectedDista
         const float d = distances[i]->at<float>(v, u);
         sum += std::min(static_cast<double>(d), kTruncationPx);
         ++count;
-        ++bins[std::min(kBins - 1, static_cast<int>(d / kHistogramBinPx))];
+        ++bins[std::min(kBins - 1,
+                        static_cast<int>(std::min(static_cast<double>(d), kHistogramRangePx) /
+                                         kHistogramBinPx))];
       }
       capped_sum_[at] += sum;
       count_[at] += count;
@@ -91,7 +93,7 @@ double ShiftedDistances::cost(cv::Point shift) const {
 
 DistanceQuantiles ShiftedDistances::quantiles(cv::Point shift) const {
   const std::size_t at = index(shift);
-  const std::uint32_t* bins = &histogram_[at * kBins];
+  const std::uint64_t* bins = &histogram_[at * kBins];
   // The upper end of the bin where the cumulative count reaches the fraction.
   const auto quantile = [&](double fraction) {
     const double wanted = fraction * static_cast<double>(count_[at]);

@@ -87,7 +87,7 @@ class ShiftedDistances {
 
   std::vector<double> capped_sum_;        // per shift
   std::vector<std::uint64_t> count_;      // per shift: edge pixels moved inside the image
-  std::vector<std::uint32_t> histogram_;  // per shift, per bin
+  std::vector<std::uint64_t> histogram_;  // per shift, per bin
   std::uint64_t color_edge_pixels_ = 0;
 };
 

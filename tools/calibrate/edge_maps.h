@@ -14,9 +14,9 @@ namespace tilth::calibrate {
 
 // Central differences (two pixels apart, so a mixed ToF pixel halfway up a jump does not
 // split it) beyond this are depth edges. The simulated range noise (1 mm at 500 mm) puts
-// a difference's spread at 1.5 mm: 6 mm is four of them, a few hundred false pixels a
-// frame on bare soil, while a straw resting on straw or a stalk standing out of the soil
-// jumps more.
+// a difference's spread at 1.5 mm: 6 mm is four of them, a few tens of false pixels a
+// frame on bare soil (the tails beyond four spreads), while a straw resting on straw or a stalk
+// standing out of the soil jumps more.
 constexpr double kDepthJumpMm = 6.0;
 
 // Canny's thresholds on the grey registered colour (3x3 Sobel, L2 gradient): a step of

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -26,7 +27,9 @@
 #include "rig_facts.h"
 #include "rig_solver.h"
 #include "solve_report.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
+#include "view_capture.h"
 
 namespace {
 
@@ -77,6 +80,30 @@ constexpr const char* kUsage = R"(usage: tilth calibrate COMMAND ARGS
         --report OUT.json
                         per frame and overall: edges used, distances, offset, verdict
 
+  capture (--recording DIR | --tof CAMERA --color CAMERA) --board COLSxROWS
+          --out DIR
+      Views for solve, from a stream of frame pairs: a pair is kept when the board
+      is found in both images, held still, and placed unlike every view kept so
+      far (its position, size and skew in the colour image, as ROS's
+      camera_calibration measures them). Each kept view is written at once as
+      DIR/NNN_intensity.png and DIR/NNN_color.png (BGR or grey), and the parts of
+      either image the board has not reached yet are printed.
+        --recording DIR an image-folder recording whose depth images hold the ToF
+                        intensity (recorded with the ToF camera's Intensity component)
+        --tof CAMERA --color CAMERA
+                        live, from the GigE Vision cameras (an address, serial number
+                        or device id): the ToF camera streams its Intensity component
+                        in Mono16, paired with the colour camera by capture time
+        --views N       stop after keeping N views (default 20)
+        --frames N      look at N frame pairs at most
+        --still-px P    how far the board's corners may move between pairs, in each
+                        image's pixels, and still count as held still (default 1)
+        --set NODE.PARAM=VALUE
+                        a parameter of the graph's nodes, as tilth run --set: live,
+                        tof and color (aravis.tof_camera, aravis.color_camera: e.g.
+                        tof.exposure_us=800) and pair (pairing.depth_color); from a
+                        recording, recording (recording.image_folder)
+
 What neither the views nor Basler's file say (solve and import):
   --base RIG.calib.json   a calibration of the same rig whose other fields are kept
   --gray-to-mm G          the ToF camera's Scan3dCoordinateScale (mm per gray value)
@@ -91,21 +118,43 @@ Without --base, --gray-to-mm and --z-offset-mm are required.
 
 Nothing is written when anything fails. Exit code 0 on success (check: the
 calibration holds), 1 when the input cannot be read or solved, 2 for bad usage;
-check: 4 when it says recalibrate, 5 when the frames cannot tell (too few edges).
+check: 4 when it says recalibrate, 5 when the frames cannot tell (too few edges, or
+no distinct best shift);
+capture: 5 when it kept fewer views than solve needs (6).
 )";
 
 constexpr int kExitRecalibrate = 4;
 constexpr int kExitCannotJudge = 5;
 constexpr std::uint64_t kDefaultCheckFrames = 30;
+constexpr std::uint64_t kDefaultViews = 20;
 
+// What neither the views nor Basler's file say (rig_facts.h).
+const std::set<std::string> kRigFactOptions = {
+    "--base",           "--depth-model", "--color-model", "--depth-measure", "--gray-to-mm",
+    "--gray-offset-mm", "--z-offset-mm", "--depth-size",  "--color-size"};
+
+std::set<std::string> with_rig_facts(std::set<std::string> options) {
+  options.insert(kRigFactOptions.begin(), kRigFactOptions.end());
+  return options;
+}
+
+const std::set<std::string> kSolveOptions =
+    with_rig_facts({"--out", "--board", "--square-mm", "--depth-intrinsics", "--depth-camera",
+                    "--color-bayer", "--report"});
+const std::set<std::string> kImportOptions = with_rig_facts({"--out"});
 const std::set<std::string> kCheckOptions = {"--calibration", "--frames", "--max-offset-px",
-                                             "--overlay"};
+                                             "--overlay", "--report"};
+const std::set<std::string> kCaptureOptions = {"--recording", "--tof",      "--color",
+                                               "--board",     "--out",      "--views",
+                                               "--frames",    "--still-px", "--set"};
 
-const std::set<std::string> kValued = {
-    "--out",           "--board",       "--square-mm",      "--depth-intrinsics", "--depth-camera",
-    "--color-bayer",   "--report",      "--base",           "--depth-model",      "--color-model",
-    "--depth-measure", "--gray-to-mm",  "--gray-offset-mm", "--z-offset-mm",      "--depth-size",
-    "--color-size",    "--calibration", "--frames",         "--max-offset-px",    "--overlay"};
+std::set<std::string> all_valued() {
+  std::set<std::string> all;
+  for (const auto* options : {&kSolveOptions, &kImportOptions, &kCheckOptions, &kCaptureOptions}) {
+    all.insert(options->begin(), options->end());
+  }
+  return all;
+}
 
 int usage_error(const std::string& message) {
   std::cerr << "tilth calibrate: " << message << "\n\n" << kUsage;
@@ -204,7 +253,7 @@ fs::path default_report(const fs::path& calibration) {
 // A command refuses the options of another, rather than ignore them.
 std::optional<std::string> foreign_option(const CommandLine& line,
                                           const std::set<std::string>& own) {
-  for (const std::string& option : kValued) {
+  for (const std::string& option : all_valued()) {
     if (!own.count(option) && line.value(option)) return option;
   }
   return std::nullopt;
@@ -218,8 +267,8 @@ int solve(const CommandLine& line) {
   if (!out || !board_text || !square_mm) {
     return usage_error("solve needs --board COLSxROWS, --square-mm S and --out RIG.calib.json");
   }
-  for (const std::string& option : kCheckOptions) {
-    if (line.value(option)) return usage_error(option + " is a check option");
+  if (const auto option = foreign_option(line, kSolveOptions)) {
+    return usage_error(*option + " is not a solve option");
   }
   tilth::calibrate::SolveOptions options;
   options.inner_corners = parse_board(*board_text);
@@ -275,12 +324,8 @@ int import(const CommandLine& line) {
   const auto out = line.value("--out");
   if (line.positional().size() != 2 || !out)
     return usage_error("import takes BASLER.xml --out RIG.calib.json");
-  for (const char* option : {"--board", "--square-mm", "--depth-intrinsics", "--depth-camera",
-                             "--color-bayer", "--report"}) {
-    if (line.value(option)) return usage_error(std::string(option) + " is a solve option");
-  }
-  for (const std::string& option : kCheckOptions) {
-    if (line.value(option)) return usage_error(option + " is a check option");
+  if (const auto option = foreign_option(line, kImportOptions)) {
+    return usage_error(*option + " is not an import option");
   }
   const fs::path calibration = *out;
   check_output(calibration, line.flag("--overwrite"));
@@ -294,8 +339,7 @@ int import(const CommandLine& line) {
 void print_check(const tilth::calibrate::CheckResult& result, const std::string& recording) {
   using tilth::calibrate::Verdict;
   const auto& o = result.overall;
-  std::size_t judged = 0;
-  for (const auto& frame : result.frames) judged += frame.summary.cannot_judge.empty();
+  const std::size_t judged = result.judged_frames;
   const auto old_flags = std::cout.flags();
   const auto old_precision = std::cout.precision(2);
   std::cout << std::fixed;
@@ -322,8 +366,7 @@ void print_check(const tilth::calibrate::CheckResult& result, const std::string&
 int check(const CommandLine& line) {
   namespace calibrate = tilth::calibrate;
   if (line.positional().size() != 2) return usage_error("check takes RECORDING (an image folder)");
-  if (const auto option = foreign_option(
-          line, {"--calibration", "--frames", "--max-offset-px", "--overlay", "--report"})) {
+  if (const auto option = foreign_option(line, kCheckOptions)) {
     return usage_error(*option + " is not a check option");
   }
   const std::string recording = line.positional()[1];
@@ -347,23 +390,26 @@ int check(const CommandLine& line) {
 
   const calibrate::CheckResult result =
       calibrate::check_calibration(recording, replay, max_offset_px);
-  if (report) {
-    const nlohmann::json document =
-        calibrate::check_report(result, recording, replay.calibration.value_or("").string());
-    write_file(*report, document.dump(2) + "\n");
-  }
+  // Both made before either is written: nothing is written when anything fails.
+  std::vector<std::uint8_t> png;
   if (overlay) {
     std::ostringstream caption;
     caption << std::fixed << std::setprecision(2) << "frame " << result.overlay_frame_id << ": "
             << to_string(result.verdict) << ", offset (" << result.overall.offset_px.x << ", "
             << result.overall.offset_px.y << ") px; magenta depth edges, green colour edges";
-    std::vector<std::uint8_t> png;
-    cv::imencode(".png",
-                 calibrate::alignment_overlay(result.overlay_bgr, result.overlay_depth_edges,
-                                              result.overlay_color_edges, caption.str()),
-                 png);
-    write_file(*overlay, std::string(png.begin(), png.end()));
+    if (!cv::imencode(".png",
+                      calibrate::alignment_overlay(result.overlay_bgr, result.overlay_depth_edges,
+                                                   result.overlay_color_edges, caption.str()),
+                      png)) {
+      throw Error(*overlay + ": cannot encode the overlay as PNG");
+    }
   }
+  if (report) {
+    const nlohmann::json document =
+        calibrate::check_report(result, recording, replay.calibration.value_or("").string());
+    write_file(*report, document.dump(2) + "\n");
+  }
+  if (overlay) write_file(*overlay, std::string(png.begin(), png.end()));
   print_check(result, recording);
   switch (result.verdict) {
     case calibrate::Verdict::kHolds:
@@ -376,12 +422,75 @@ int check(const CommandLine& line) {
   return kExitFailed;
 }
 
+// NODE.PARAM=VALUE
+tilth::calibrate::NodeSetting node_setting(const std::string& text) {
+  const auto equals = text.find('=');
+  const auto dot = text.find('.');
+  if (equals == std::string::npos || dot == std::string::npos || dot == 0 || dot + 1 >= equals) {
+    throw Error("--set: expected NODE.PARAM=VALUE (e.g. tof.exposure_us=800), got '" + text + "'");
+  }
+  return {text.substr(0, dot), text.substr(dot + 1, equals - dot - 1), text.substr(equals + 1),
+          "--set " + text};
+}
+
+int capture(const CommandLine& line) {
+  namespace calibrate = tilth::calibrate;
+  if (line.positional().size() != 1) return usage_error("capture takes no arguments, only options");
+  if (const auto option = foreign_option(line, kCaptureOptions)) {
+    return usage_error(*option + " is not a capture option");
+  }
+  const auto recording = line.value("--recording");
+  const auto tof = line.value("--tof");
+  const auto color = line.value("--color");
+  const auto out = line.value("--out");
+  const auto board = line.value("--board");
+  if (!out || !board) return usage_error("capture needs --board COLSxROWS and --out DIR");
+  if (recording.has_value() == (tof.has_value() || color.has_value()) ||
+      tof.has_value() != color.has_value()) {
+    return usage_error("capture reads --recording DIR, or --tof CAMERA and --color CAMERA");
+  }
+  calibrate::CaptureOptions options;
+  options.out = *out;
+  options.selection.inner_corners = parse_board(*board);
+  calibrate::PairStream stream;
+  stream.source = recording ? calibrate::PairSource(fs::path(*recording))
+                            : calibrate::PairSource(calibrate::LiveCameras{*tof, *color});
+  try {
+    options.views = line.count("--views", 1, 1000).value_or(kDefaultViews);
+    stream.max_frames = line.count("--frames", 1, std::numeric_limits<std::uint32_t>::max());
+    options.selection.still_px = line.real("--still-px", 0.05, 100.0).value_or(1.0);
+    for (const std::string& text : line.values("--set"))
+      stream.settings.push_back(node_setting(text));
+  } catch (const Error& error) {
+    return usage_error(error.what());
+  }
+  const calibrate::CaptureResult result = calibrate::capture_views(stream, options, std::cout);
+  std::cout << options.out.string() << ": " << result.kept << " views kept from " << result.pairs
+            << " frame pairs (the board in both images in " << result.board_pairs << ")"
+            << (result.stopped ? "; stopped" : "") << "\n";
+  if (result.color_coverage) {
+    std::cout << "board coverage (# a corner in the cell)\n  ToF       colour\n";
+    const auto& depth = result.depth_coverage->cells();
+    const auto& colour = result.color_coverage->cells();
+    for (std::size_t row = 0; row < depth.size(); ++row) {
+      std::cout << "  " << depth[row] << "  " << colour[row] << "\n";
+    }
+  }
+  if (result.kept < calibrate::kMinViews) {
+    std::cout << "fewer views than solve needs (" << calibrate::kMinViews
+              << "); better 15 to 20 spread over both images\n";
+    return kExitCannotJudge;
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  tilth::tools::install_stop_handlers("tilth calibrate");
   std::optional<CommandLine> parsed;
   try {
-    parsed.emplace(argc, argv, 1, kValued, std::set<std::string>{"--overwrite", "--help"});
+    parsed.emplace(argc, argv, 1, all_valued(), std::set<std::string>{"--overwrite", "--help"});
   } catch (const Error& error) {
     return usage_error(error.what());
   }
@@ -391,13 +500,14 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (line.positional().empty()) {
-    return usage_error("expected a command: solve, import or check");
+    return usage_error("expected a command: solve, import, check or capture");
   }
   const std::string& command = line.positional()[0];
   try {
     if (command == "solve") return solve(line);
     if (command == "import") return import(line);
     if (command == "check") return check(line);
+    if (command == "capture") return capture(line);
     return usage_error("unknown command '" + command + "'");
   } catch (const std::exception& error) {
     std::cerr << "tilth calibrate: " << error.what() << "\n";

@@ -46,8 +46,8 @@ StageDescriptor collector(const std::function<void(const RegisteredFrame&)>& on_
 
 }  // namespace
 
-RunResult replay_registered(const std::filesystem::path& recording, const ReplayOptions& options,
-                            const std::function<void(const RegisteredFrame&)>& on_frame) {
+void replay_registered(const std::filesystem::path& recording, const ReplayOptions& options,
+                       const std::function<void(const RegisteredFrame&)>& on_frame) {
   tools::InProcessGraph graph(kProgram);
   graph.add_stage_type(collector(on_frame));
   const std::string calibration = options.calibration ? options.calibration->string() : "";
@@ -63,9 +63,11 @@ RunResult replay_registered(const std::filesystem::path& recording, const Replay
   graph.add_edge("project.depth", "check.depth");
   graph.add_edge("register.color", "check.color");
   graph.set_runtime({4, FullPolicy::kBlock, ErrorPolicy::kStop});
-  RunResult result = graph.run(RunLimits{options.max_frames});
+  const RunResult result = graph.run(RunLimits{options.max_frames});
   if (result.failed) throw Error(result.failure);
-  return result;
+  // A partial recording is not judged.
+  if (result.stopped)
+    throw Error(recording.string() + ": the check was stopped before its frames ended");
 }
 
 }  // namespace tilth::calibrate

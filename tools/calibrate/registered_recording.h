@@ -10,8 +10,6 @@
 
 #include <opencv2/core/mat.hpp>
 
-#include "framework/runtime.h"
-
 namespace tilth::calibrate {
 
 struct RegisteredFrame {
@@ -33,8 +31,9 @@ struct ReplayOptions {
 // pixel keeps the colour the camera saw there, so colour edges stay where the colour
 // camera put them rather than where the depth says an occluded band begins. Throws
 // tilth::Error when a stage cannot start (no recording, a malformed calibration) or a
-// frame fails (a calibration for other image sizes), naming the node and the file.
-RunResult replay_registered(const std::filesystem::path& recording, const ReplayOptions& options,
-                            const std::function<void(const RegisteredFrame&)>& on_frame);
+// frame fails (a calibration for other image sizes), naming the node and the file, and
+// when a stop signal ends the replay early.
+void replay_registered(const std::filesystem::path& recording, const ReplayOptions& options,
+                       const std::function<void(const RegisteredFrame&)>& on_frame);
 
 }  // namespace tilth::calibrate

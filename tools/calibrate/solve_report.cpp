@@ -1,29 +1,19 @@
 #include "solve_report.h"
 
-#include <algorithm>
 #include <vector>
+
+#include "board_coverage.h"
 
 namespace tilth::calibrate {
 namespace {
 
-// Rows of '#' (a corner fell in the cell) and '.' (none), and the covered fraction.
 nlohmann::json coverage(const std::vector<std::vector<cv::Point2f>>& views,
                         const CameraIntrinsics& camera) {
-  std::vector<std::string> rows(kCoverageRows, std::string(kCoverageColumns, '.'));
-  for (const auto& corners : views) {
-    for (const auto& corner : corners) {
-      const int col = static_cast<int>((corner.x + 0.5) * kCoverageColumns / camera.width);
-      const int row = static_cast<int>((corner.y + 0.5) * kCoverageRows / camera.height);
-      if (col >= 0 && col < kCoverageColumns && row >= 0 && row < kCoverageRows) {
-        rows[row][col] = '#';
-      }
-    }
-  }
-  int covered = 0;
-  for (const auto& row : rows) covered += static_cast<int>(std::count(row.begin(), row.end(), '#'));
-  return {{"grid", {kCoverageColumns, kCoverageRows}},
-          {"cells", rows},
-          {"covered_fraction", static_cast<double>(covered) / (kCoverageColumns * kCoverageRows)}};
+  BoardCoverage grid({camera.width, camera.height});
+  for (const auto& corners : views) grid.add(corners);
+  return {{"grid", {BoardCoverage::kColumns, BoardCoverage::kRows}},
+          {"cells", grid.cells()},
+          {"covered_fraction", grid.covered_fraction()}};
 }
 
 nlohmann::json vec(const cv::Vec3d& value) { return {value[0], value[1], value[2]}; }

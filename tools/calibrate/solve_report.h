@@ -11,11 +11,6 @@
 
 namespace tilth::calibrate {
 
-// The coarse grid over each image whose cells report whether a used view's corner fell
-// in them; an uncovered cell leaves the lens model unchecked there.
-constexpr int kCoverageColumns = 8;
-constexpr int kCoverageRows = 6;
-
 // `calibration` names the file written; `options` are the board and the ToF mode.
 nlohmann::json solve_report(const SolveResult& result, const SolveOptions& options,
                             const std::string& calibration);

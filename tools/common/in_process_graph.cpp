@@ -57,12 +57,26 @@ void InProcessGraph::add_stage_type(StageDescriptor descriptor) {
   own_types_.push_back(std::move(descriptor));
 }
 
-RunResult InProcessGraph::run(RunLimits limits) const {
+RunResult InProcessGraph::run(RunLimits limits) {
   const auto registry = load_plugins({});
   for (const StageDescriptor& descriptor : own_types_) registry->add(descriptor, program_);
   Runtime runtime(validate_graph(spec_, *registry), *registry, limits);
+  {
+    std::lock_guard lock(mutex_);
+    running_ = &runtime;
+    if (stop_wanted_) runtime.stop();
+  }
   const StopSignalWatcher watcher(program_, [&runtime] { runtime.stop(); });
-  return runtime.run();
+  RunResult result = runtime.run();
+  std::lock_guard lock(mutex_);
+  running_ = nullptr;
+  return result;
+}
+
+void InProcessGraph::stop() {
+  std::lock_guard lock(mutex_);
+  stop_wanted_ = true;
+  if (running_ != nullptr) running_->stop();
 }
 
 }  // namespace tilth::tools

@@ -3,6 +3,7 @@
 // validation and the same runtime. Tools name stages; the framework knows none.
 #pragma once
 
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,10 @@ class InProcessGraph {
   // (throws tilth::Error naming each that failed to start) and runs until the sources end,
   // `limits` are reached, or a stop signal stops it as it stops `tilth run` (RunResult::stopped;
   // the program calls install_stop_handlers first).
-  RunResult run(RunLimits limits = {}) const;
+  RunResult run(RunLimits limits = {});
+  // From any thread, a stage the program added among them: the run stops as on a stop
+  // signal (frames in flight finish); before run(), it stops at once.
+  void stop();
 
  private:
   NodeSpec& node(const std::string& name);
@@ -45,6 +49,10 @@ class InProcessGraph {
   const std::string program_;
   GraphSpec spec_;
   std::vector<StageDescriptor> own_types_;
+
+  std::mutex mutex_;
+  Runtime* running_ = nullptr;
+  bool stop_wanted_ = false;
 };
 
 }  // namespace tilth::tools

@@ -48,7 +48,7 @@ class TemporaryFolder {
   fs::path path_;
 };
 
-RunResult run_conversion(const InProcessGraph& graph, const std::string& what) {
+RunResult run_conversion(InProcessGraph& graph, const std::string& what) {
   RunResult result = graph.run();
   if (result.failed) throw Error(what + " failed: " + result.failure);
   return result;
