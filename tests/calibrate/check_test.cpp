@@ -169,7 +169,7 @@ TEST_F(CalibrateCheck, BareSoilCannotBeJudged) {
   EXPECT_NE(output_.find("too few edges to go by"), std::string::npos) << output_;
 }
 
-TEST_F(CalibrateCheck, AMissingRecordingIsRefused) {
+TEST_F(CalibrateCheck, AMissingRecordingOrCalibrationIsRefused) {
   const fs::path missing = own_.path() / "no-such-recording";
   const auto report = check(missing.string(), 1);
   EXPECT_TRUE(report.is_null());
@@ -177,6 +177,12 @@ TEST_F(CalibrateCheck, AMissingRecordingIsRefused) {
                          missing.string() + "/recording.json: cannot read"),
             std::string::npos)
       << output_;
+  const fs::path no_calibration = own_.path() / "no.calib.json";
+  EXPECT_TRUE(check(recording("straw").string() + " --calibration " + no_calibration.string(), 1)
+                  .is_null());
+  EXPECT_NE(output_.find("node 'project' (depth.projection) failed to start"), std::string::npos)
+      << output_;
+  EXPECT_NE(output_.find(no_calibration.string()), std::string::npos) << output_;
 }
 
 TEST_F(CalibrateCheck, ACalibrationForAnotherImageSizeIsRefused) {
@@ -212,6 +218,21 @@ TEST_F(CalibrateCheck, BadUsageIsRefused) {
   EXPECT_NE(foreign.output.find("--board is not a check option"), std::string::npos)
       << foreign.output;
   EXPECT_EQ(run_calibrate("check " + straw + " --frames 0").exit_code, 2);
+  const auto unknown = run_calibrate("check " + straw + " --bogus");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("unknown option --bogus"), std::string::npos) << unknown.output;
+  // Beyond the 20 px searched.
+  const auto far = run_calibrate("check " + straw + " --max-offset-px 25");
+  EXPECT_EQ(far.exit_code, 2);
+  EXPECT_NE(far.output.find("--max-offset-px"), std::string::npos) << far.output;
+  const fs::path overlay = own_.write("overlay.png", "kept");
+  const auto existing = run_calibrate("check " + straw + " --overlay " + overlay.string());
+  EXPECT_EQ(existing.exit_code, 1);
+  EXPECT_NE(existing.output.find(overlay.string() + ": exists; use --overwrite to replace it"),
+            std::string::npos)
+      << existing.output;
+  std::ifstream kept(overlay);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept), {}), "kept");
 }
 
 }  // namespace

@@ -42,12 +42,16 @@ Scene draw_scene(cv::Point shift, cv::Point shadow) {
   return scene;
 }
 
-cv::Point2d measured_offset(const Scene& scene, NearSide side) {
+ShiftedDistances distances_of(const Scene& scene, NearSide side) {
   const cv::Mat region(scene.bgr.size(), CV_8UC1, cv::Scalar(255));
   ShiftedDistances distances;
   distances.add_frame(depth_edges(scene.depth_mm),
                       DirectedDistances(color_edges(scene.bgr, region)), side);
-  return distances.best_offset();
+  return distances;
+}
+
+cv::Point2d measured_offset(const Scene& scene, NearSide side) {
+  return distances_of(scene, side).best_offset();
 }
 
 TEST(EdgeAlignment, AlignedEdgesGiveNoOffset) {
@@ -71,10 +75,18 @@ TEST(EdgeAlignment, ShadowsBesideTheDiscsDoNotPullTheMatch) {
   // The shadow's outer edge is parallel to the disc's, 3 px further on, but darker
   // outside-in: of the other polarity, so not matched with the disc's depth edge.
   // Measured: the same offset to 0.001 px.
-  const cv::Point2d plain = measured_offset(draw_scene({4, -3}, {}), NearSide::kBrighter);
-  const cv::Point2d shaded = measured_offset(draw_scene({4, -3}, {3, 3}), NearSide::kBrighter);
-  EXPECT_NEAR(shaded.x, plain.x, 0.25);
-  EXPECT_NEAR(shaded.y, plain.y, 0.25);
+  const ShiftedDistances plain = distances_of(draw_scene({4, -3}, {}), NearSide::kBrighter);
+  const ShiftedDistances shaded = distances_of(draw_scene({4, -3}, {3, 3}), NearSide::kBrighter);
+  EXPECT_NEAR(shaded.best_offset().x, plain.best_offset().x, 0.25);
+  EXPECT_NEAR(shaded.best_offset().y, plain.best_offset().y, 0.25);
+  // At the shadows' own shift the depth edges find no more to match than without them:
+  // the shadows' edges were not taken for the discs'.
+  EXPECT_NEAR(shaded.cost({7, 0}), plain.cost({7, 0}), 0.05 * plain.cost({7, 0}));
+  // Taken as the other polarity, they would be: the darker side's cost there drops.
+  const ShiftedDistances plain_darker = distances_of(draw_scene({4, -3}, {}), NearSide::kDarker);
+  const ShiftedDistances shaded_darker =
+      distances_of(draw_scene({4, -3}, {3, 3}), NearSide::kDarker);
+  EXPECT_LT(shaded_darker.cost({7, 0}), 0.8 * plain_darker.cost({7, 0}));
 }
 
 TEST(EdgeAlignment, TheWrongPolarityMatchesWorse) {
