@@ -95,7 +95,7 @@ TEST_F(CalibrateCapture, KeepsTheThirdStillFrameOfEachPoseOnceAndStopsAtViews) {
             std::string::npos)
       << run.output;
   for (int pose = 0; pose < kPoses; ++pose) {
-    char name[8];
+    char name[16];
     std::snprintf(name, sizeof name, "%03d", pose);
     // Three frames still in a row: the hold's first (moved from the last moving frame, or
     // the recording's first), second and third.
@@ -109,7 +109,7 @@ TEST_F(CalibrateCapture, KeepsTheThirdStillFrameOfEachPoseOnceAndStopsAtViews) {
     cv::cvtColor(kept.color, expected, cv::COLOR_BayerBG2BGR);  // OpenCV's name for RG
     EXPECT_TRUE(same_pixels(expected, color)) << name;
   }
-  char after_last[8];
+  char after_last[16];
   std::snprintf(after_last, sizeof after_last, "%03d", kPoses);
   EXPECT_FALSE(fs::exists(views / (std::string(after_last) + "_intensity.png")));
 
