@@ -32,8 +32,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
-
+#include "color/color_conversion.h"
 #include "color_sampler.h"
 #include "depth_to_color.h"
 #include "roi/region_of_interest.h"
@@ -292,17 +291,12 @@ class ProjectiveRegistration final : public Transform {
   }
 
  private:
-  // Bilinear sampling blends demosaiced pixels. OpenCV names a mosaic by its second
-  // row's second and third pixels, one pixel off the usual naming by the top-left tile.
+  // Bilinear sampling blends demosaiced pixels.
   void register_bilinear(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color,
                          Rows rows, Scratch& scratch, RegisteredColor& out) const {
     const auto run = [&](const auto& sampler) {
       registration::register_bilinear(geometry.map, geometry.cells, depth, sampler,
                                       occlusion_tolerance_mm_, rows, scratch, out);
-    };
-    const auto demosaiced = [&](int opencv_code) {
-      cv::cvtColor(color.pixels, scratch.demosaiced, opencv_code);
-      return BgrSampler(scratch.demosaiced);
     };
     switch (color.format) {
       case PixelFormat::kBgr8:
@@ -312,13 +306,11 @@ class ProjectiveRegistration final : public Transform {
       case PixelFormat::kMono8:
         return run(MonoSampler(color.pixels));
       case PixelFormat::kBayerRggb8:
-        return run(demosaiced(cv::COLOR_BayerBG2BGR));
       case PixelFormat::kBayerBggr8:
-        return run(demosaiced(cv::COLOR_BayerRG2BGR));
       case PixelFormat::kBayerGrbg8:
-        return run(demosaiced(cv::COLOR_BayerGB2BGR));
       case PixelFormat::kBayerGbrg8:
-        return run(demosaiced(cv::COLOR_BayerGR2BGR));
+        color::to_bgr(color.pixels, color.format, scratch.demosaiced);
+        return run(BgrSampler(scratch.demosaiced));
     }
   }
 

@@ -39,7 +39,7 @@ class BoardViews : public ::testing::Test {
 
   // find_board on `intensity` and `color` written as view NAME.
   calibrate::BoardView found(const cv::Mat& intensity, const cv::Mat& color,
-                             calibrate::ColorMosaic mosaic) {
+                             std::optional<PixelFormat> mosaic) {
     cv::imwrite((dir_.path() / "v_intensity.png").string(), intensity);
     cv::imwrite((dir_.path() / "v_color.png").string(), color);
     const auto views = calibrate::find_views({dir_.path()});
@@ -65,7 +65,7 @@ class BoardViews : public ::testing::Test {
 };
 
 TEST_F(BoardViews, SixteenBitIntensityAndBayerMosaic) {
-  expect_corners(found(intensity_, mosaic_, calibrate::ColorMosaic::kRg));
+  expect_corners(found(intensity_, mosaic_, PixelFormat::kBayerRggb8));
 }
 
 TEST_F(BoardViews, EightBitIntensityAndBgrColour) {
@@ -73,20 +73,20 @@ TEST_F(BoardViews, EightBitIntensityAndBgrColour) {
   intensity_.convertTo(intensity8, CV_8U, 255.0 / 3500.0);
   cv::Mat bgr;
   cv::cvtColor(mosaic_, bgr, cv::COLOR_BayerBG2BGR);
-  expect_corners(found(intensity8, bgr, calibrate::ColorMosaic::kNone));
+  expect_corners(found(intensity8, bgr, std::nullopt));
 }
 
 TEST_F(BoardViews, GreyColour) {
   cv::Mat grey;
   cv::cvtColor(mosaic_, grey, cv::COLOR_BayerBG2GRAY);
-  expect_corners(found(intensity_, grey, calibrate::ColorMosaic::kNone));
+  expect_corners(found(intensity_, grey, std::nullopt));
 }
 
 TEST_F(BoardViews, BgrColourCalledBayerIsRefused) {
   cv::Mat bgr;
   cv::cvtColor(mosaic_, bgr, cv::COLOR_BayerBG2BGR);
   try {
-    found(intensity_, bgr, calibrate::ColorMosaic::kRg);
+    found(intensity_, bgr, PixelFormat::kBayerRggb8);
     ADD_FAILURE() << "a 3-channel image read as a Bayer mosaic";
   } catch (const Error& error) {
     EXPECT_NE(std::string(error.what()).find("v_color.png: has 3 channels, but --color-bayer"),

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "color/color_conversion.h"
 #include "tilth/error.h"
 
 namespace tilth::calibrate {
@@ -27,27 +28,19 @@ cv::Mat read_image(const fs::path& file) {
   return image;
 }
 
-cv::Mat color_to_gray(const cv::Mat& color, ColorMosaic mosaic, const fs::path& file) {
+cv::Mat color_to_gray(const cv::Mat& color, std::optional<PixelFormat> mosaic,
+                      const fs::path& file) {
   if (color.depth() != CV_8U || (color.channels() != 1 && color.channels() != 3)) {
     throw Error(file.string() +
                 ": expected an 8-bit colour image (1 channel: Bayer or grey; 3: BGR)");
   }
-  if (color.channels() == 3) {
-    if (mosaic != ColorMosaic::kNone) {
-      throw Error(file.string() + ": has 3 channels, but --color-bayer says it is a Bayer mosaic");
-    }
-    cv::Mat gray;
-    cv::cvtColor(color, gray, cv::COLOR_BGR2GRAY);
-    return gray;
+  if (color.channels() == 3 && mosaic) {
+    throw Error(file.string() + ": has 3 channels, but --color-bayer says it is a Bayer mosaic");
   }
-  // OpenCV names a pattern by the second row's first two pixels.
-  static const std::map<ColorMosaic, int> kCodes = {{ColorMosaic::kRg, cv::COLOR_BayerBG2GRAY},
-                                                    {ColorMosaic::kBg, cv::COLOR_BayerRG2GRAY},
-                                                    {ColorMosaic::kGr, cv::COLOR_BayerGB2GRAY},
-                                                    {ColorMosaic::kGb, cv::COLOR_BayerGR2GRAY}};
-  if (mosaic == ColorMosaic::kNone) return color;
+  const PixelFormat format =
+      color.channels() == 3 ? PixelFormat::kBgr8 : mosaic.value_or(PixelFormat::kMono8);
   cv::Mat gray;
-  cv::cvtColor(color, gray, kCodes.at(mosaic));
+  color::to_gray(color, format, gray);
   return gray;
 }
 
@@ -156,11 +149,11 @@ std::vector<cv::Point2f> board_corners(const cv::Mat& gray, cv::Size inner_corne
   return corners;
 }
 
-ColorMosaic parse_color_mosaic(const std::string& text) {
-  static const std::map<std::string, ColorMosaic> kMosaics = {{"RG", ColorMosaic::kRg},
-                                                              {"BG", ColorMosaic::kBg},
-                                                              {"GR", ColorMosaic::kGr},
-                                                              {"GB", ColorMosaic::kGb}};
+std::optional<PixelFormat> parse_color_mosaic(const std::string& text) {
+  static const std::map<std::string, PixelFormat> kMosaics = {{"RG", PixelFormat::kBayerRggb8},
+                                                              {"BG", PixelFormat::kBayerBggr8},
+                                                              {"GR", PixelFormat::kBayerGrbg8},
+                                                              {"GB", PixelFormat::kBayerGbrg8}};
   const auto found = kMosaics.find(text);
   if (found == kMosaics.end()) {
     throw Error(
@@ -186,7 +179,8 @@ cv::Mat intensity_to_8bit(const cv::Mat& intensity) {
   return scaled;
 }
 
-BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic mosaic) {
+BoardView find_board(const ViewFiles& files, cv::Size inner_corners,
+                     std::optional<PixelFormat> mosaic) {
   const cv::Mat intensity = read_image(files.intensity);
   if (intensity.channels() != 1 || (intensity.depth() != CV_8U && intensity.depth() != CV_16U)) {
     throw Error(files.intensity.string() +
@@ -206,7 +200,7 @@ BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic
 }
 
 std::vector<BoardView> find_boards(const std::vector<ViewFiles>& views, cv::Size inner_corners,
-                                   ColorMosaic mosaic) {
+                                   std::optional<PixelFormat> mosaic) {
   std::vector<BoardView> boards(views.size());
   std::vector<std::exception_ptr> errors(views.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {

@@ -4,10 +4,13 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core/types.hpp>
+
+#include "tilth/messages/color_image.h"
 
 namespace tilth::calibrate {
 
@@ -22,12 +25,11 @@ struct ViewFiles {
 // folder, a folder without pairs, and an image whose partner is missing.
 std::vector<ViewFiles> find_views(const std::vector<std::filesystem::path>& folders);
 
-// How the colour camera's 1-channel images are to be read: as grey, or as a Bayer mosaic
-// named by its first row's first two pixels (GenICam's BayerRG8 is kRg: R G / G B).
-enum class ColorMosaic { kNone, kRg, kBg, kGr, kGb };
-
-// "RG" -> kRg; throws tilth::Error for another text.
-ColorMosaic parse_color_mosaic(const std::string& text);
+// How the colour camera's 1-channel images are to be read: as grey (nullopt), or as a
+// Bayer mosaic named by its first row's first two pixels, as `--color-bayer` names it:
+// "RG" (GenICam's BayerRG8: R G / G B) -> PixelFormat::kBayerRggb8. Throws tilth::Error
+// for another text.
+std::optional<PixelFormat> parse_color_mosaic(const std::string& text);
 
 // kThorough: an exhaustive search (the solve; a second or two for a 1280x1024 image);
 // kQuick: none (live capture; about 50 ms for 640x512), which misses more boards. Both
@@ -51,12 +53,13 @@ struct BoardView {
 // The images read and the board's `inner_corners` (columns x rows) found in each. Throws
 // tilth::Error naming the file when an image cannot be read or has the wrong type (the
 // intensity: 1 channel, 8 or 16 bits; the colour: 8 bits, 1 channel or 3 (BGR)).
-BoardView find_board(const ViewFiles& files, cv::Size inner_corners, ColorMosaic mosaic);
+BoardView find_board(const ViewFiles& files, cv::Size inner_corners,
+                     std::optional<PixelFormat> mosaic);
 
 // find_board of every view, on all cores (a second or two per colour image); throws the
 // error of the first view that has one.
 std::vector<BoardView> find_boards(const std::vector<ViewFiles>& views, cv::Size inner_corners,
-                                   ColorMosaic mosaic);
+                                   std::optional<PixelFormat> mosaic);
 
 // The ToF intensity scaled to 8 bits: its 1st percentile to 0 and its 99th to 255, so
 // the board's contrast fills the range whatever the exposure.

@@ -1,7 +1,6 @@
 #include "camera_pairs.h"
 
-#include <opencv2/imgproc.hpp>
-
+#include "color/color_conversion.h"
 #include "in_process_graph.h"
 #include "tilth/error.h"
 #include "tilth/messages/color_image.h"
@@ -15,29 +14,10 @@ constexpr const char* kProgram = "tilth calibrate capture";
 constexpr const char* kLookerType = "calibrate.pairs";
 
 cv::Mat bgr_or_gray(const ColorImage& color) {
-  cv::Mat out;
-  switch (color.format) {
-    case PixelFormat::kBgr8:
-    case PixelFormat::kMono8:
-      return color.pixels.clone();
-    case PixelFormat::kRgb8:
-      cv::cvtColor(color.pixels, out, cv::COLOR_RGB2BGR);
-      return out;
-    // OpenCV names a mosaic by its second row's first two pixels.
-    case PixelFormat::kBayerRggb8:
-      cv::cvtColor(color.pixels, out, cv::COLOR_BayerBG2BGR);
-      return out;
-    case PixelFormat::kBayerBggr8:
-      cv::cvtColor(color.pixels, out, cv::COLOR_BayerRG2BGR);
-      return out;
-    case PixelFormat::kBayerGrbg8:
-      cv::cvtColor(color.pixels, out, cv::COLOR_BayerGB2BGR);
-      return out;
-    case PixelFormat::kBayerGbrg8:
-      cv::cvtColor(color.pixels, out, cv::COLOR_BayerGR2BGR);
-      return out;
-  }
-  throw Error("colour image in an unknown pixel format");
+  if (color.format == PixelFormat::kMono8) return color.pixels.clone();
+  cv::Mat bgr;
+  color::to_bgr(color.pixels, color.format, bgr);
+  return bgr;
 }
 
 class PairLooker final : public Sink {

@@ -297,7 +297,7 @@ int solve(const CommandLine& line) {
   check_output(report, line.flag("--overwrite"));
   const auto mosaic = line.value("--color-bayer")
                           ? tilth::calibrate::parse_color_mosaic(*line.value("--color-bayer"))
-                          : tilth::calibrate::ColorMosaic::kNone;
+                          : std::nullopt;
 
   std::vector<fs::path> folders(line.positional().begin() + 1, line.positional().end());
   const auto views = tilth::calibrate::find_boards(tilth::calibrate::find_views(folders),
