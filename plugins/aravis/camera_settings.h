@@ -30,7 +30,8 @@ struct CameraSettings {
   bool packet_resend = true;
   int receive_nice = -10;  // Aravis's receiving thread; 0 = as the process
   std::vector<FeatureSetting> features;
-  std::string component;  // GenICam component to select and enable exclusively; "" = none
+  std::string component;            // GenICam component to select and enable exclusively; "" = none
+  std::string companion_component;  // enabled beside `component`, as another part; "" = none
   std::size_t buffers = 8;
   std::chrono::milliseconds timeout{0};  // 0 = two frame periods
   std::chrono::milliseconds reopen_after{1000};

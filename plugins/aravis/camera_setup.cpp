@@ -22,20 +22,32 @@ class Setup {
         label_(label),
         log_(log) {}
 
-  void select_component(const std::string& component, CameraDescription& description) {
+  // `component` enabled alone, then `companion` (if any) beside it, each delivered as a
+  // part of multi-part payloads; `component` is left selected for the settings after it
+  // (pixel format, Scan3d features), which apply to the selected component.
+  void select_components(const std::string& component, const std::string& companion,
+                         CameraDescription& description) {
     if (!features_.available("ComponentSelector")) {
+      if (!companion.empty()) {
+        throw Error("camera " + label_ +
+                    " has no components (ComponentSelector), so it cannot "
+                    "stream component '" +
+                    companion + "' beside its image");
+      }
       log_.info("camera " + label_ + " has no components (ComponentSelector): streaming its image");
       return;
     }
-    guint id = 0;
-    GErrorSlot error;
-    arv_camera_select_component(camera_, component.c_str(),
-                                ARV_COMPONENT_SELECTION_FLAGS_EXCLUSIVE_ENABLE, &id, error.out());
-    error.check("selecting component '" + component + "' of camera " + label_ +
-                " (ComponentSelector / ComponentEnable)");
-    description.component_id = id;
-    log_.info("component " + component + " selected and enabled alone (component id " +
-              std::to_string(id) + ")");
+    description.component_id = select(component, ARV_COMPONENT_SELECTION_FLAGS_EXCLUSIVE_ENABLE);
+    if (companion.empty()) {
+      log_.info("component " + component + " selected and enabled alone (component id " +
+                std::to_string(*description.component_id) + ")");
+      return;
+    }
+    description.companion_id = select(companion, ARV_COMPONENT_SELECTION_FLAGS_ENABLE);
+    select(component, ARV_COMPONENT_SELECTION_FLAGS_NONE);
+    log_.info("components " + component + " (component id " +
+              std::to_string(*description.component_id) + ") and " + companion + " (component id " +
+              std::to_string(*description.companion_id) + ") enabled, " + component + " selected");
   }
 
   void set_feature(const std::string& name, const nlohmann::json& value) {
@@ -136,6 +148,15 @@ class Setup {
   }
 
  private:
+  std::uint32_t select(const std::string& component, ArvComponentSelectionFlags flags) {
+    guint id = 0;
+    GErrorSlot error;
+    arv_camera_select_component(camera_, component.c_str(), flags, &id, error.out());
+    error.check("selecting component '" + component + "' of camera " + label_ +
+                " (ComponentSelector / ComponentEnable)");
+    return id;
+  }
+
   void require(const std::string& feature, const std::string& param) {
     if (!features_.available(feature)) {
       throw Error("camera " + label_ + " has no feature '" + feature + "' (parameter " + param +
@@ -161,7 +182,9 @@ CameraDescription configure_camera(ArvCamera* camera, const std::string& label,
   CameraDescription description;
   description.label = label;
   Setup setup(camera, label, log);
-  if (!settings.component.empty()) setup.select_component(settings.component, description);
+  if (!settings.component.empty()) {
+    setup.select_components(settings.component, settings.companion_component, description);
+  }
   if (!settings.pixel_format.empty()) setup.set_feature("PixelFormat", settings.pixel_format);
   setup.set_trigger(settings.trigger_mode, settings.trigger_source);
   if (settings.exposure_us > 0.0) {

@@ -20,6 +20,7 @@ struct CameraDescription {
   std::string pixel_format;                   // as the camera names it
   double frame_rate_hz = 0.0;                 // 0: the camera has no frame rate feature
   std::optional<std::uint32_t> component_id;  // of the selected component
+  std::optional<std::uint32_t> companion_id;  // of the component enabled beside it
   std::optional<double> scale_mm;             // Scan3dCoordinateScale, when the camera has it
   std::optional<double> offset_mm;            // Scan3dCoordinateOffset
   std::size_t payload_bytes = 0;

@@ -26,8 +26,7 @@ bool CameraSource::produce(Frame& frame) {
     frame.set_capture(arv_buffer_get_frame_id(received), device_ns,
                       static_cast<std::int64_t>(arv_buffer_get_system_timestamp(received)));
     try {
-      frame.set_output(kImage,
-                       convert(layout_of(received), buffer, session_.description(), device_ns));
+      convert(layout_of(received), buffer, session_.description(), device_ns, frame);
     } catch (const Error& error) {
       problem = "a frame of " + session_.description().label + " not passed on: " + error.what();
       if (problem != conversion_problem_) {

@@ -28,11 +28,12 @@ class CameraSource : public Source {
   void interrupt() final { session_.interrupt(); }
 
  protected:
-  // The image message of one complete buffer, its pixels lent from `buffer` (no copy);
-  // throws tilth::Error when the buffer holds nothing this stage takes.
-  virtual std::shared_ptr<const Message> convert(const BufferLayout& layout, PoppedBuffer& buffer,
-                                                 const CameraDescription& camera,
-                                                 std::int64_t device_timestamp_ns) = 0;
+  // Sets the image outputs of `frame` (kImage, and any the stage adds after kStatus) from
+  // one complete buffer, their pixels lent from `buffer` (no copy). Throws tilth::Error,
+  // having set none, when the buffer holds nothing this stage takes.
+  virtual void convert(const BufferLayout& layout, PoppedBuffer& buffer,
+                       const CameraDescription& camera, std::int64_t device_timestamp_ns,
+                       Frame& frame) = 0;
 
   // A message for one frame, from memory this source recycles.
   template <class T>

@@ -14,9 +14,8 @@ class ColorCamera final : public CameraSource {
       : CameraSource(read_camera_settings(context.params, color_formats()), context) {}
 
  private:
-  std::shared_ptr<const Message> convert(const BufferLayout& layout, PoppedBuffer& buffer,
-                                         const CameraDescription&,
-                                         std::int64_t device_timestamp_ns) override {
+  void convert(const BufferLayout& layout, PoppedBuffer& buffer, const CameraDescription&,
+               std::int64_t device_timestamp_ns, Frame& frame) override {
     const PartLayout& part = color_part(layout);
     const ImageFormat* format = find_format(color_formats(), part.pixel_format);
     if (format == nullptr) {
@@ -28,7 +27,7 @@ class ColorCamera final : public CameraSource {
     buffer.lend_to(color->pixels);
     color->format = *format->color;
     color->device_timestamp_ns = device_timestamp_ns;
-    return color;
+    frame.set_output(kImage, std::move(color));
   }
 };
 

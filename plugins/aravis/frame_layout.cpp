@@ -89,6 +89,14 @@ const PartLayout& tof_part(const BufferLayout& layout,
   return *found;
 }
 
+const PartLayout& component_part(const BufferLayout& layout, std::uint32_t component_id) {
+  for (const auto& part : layout.parts()) {
+    if (part.component_id == component_id) return part;
+  }
+  throw Error("no part of the frame belongs to component " + std::to_string(component_id) + " (" +
+              describe_parts(layout) + ")");
+}
+
 const PartLayout& color_part(const BufferLayout& layout) {
   const auto parts = layout.parts();
   if (parts.size() == 1) return parts.front();

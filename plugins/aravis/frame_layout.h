@@ -45,6 +45,9 @@ BufferLayout layout_of(ArvBuffer* buffer);
 // Throws tilth::Error describing the parts when none fits.
 const PartLayout& tof_part(const BufferLayout& layout,
                            std::optional<std::uint32_t> range_component);
+// The part of component `component_id` (as the camera numbers its components). Throws
+// tilth::Error describing the parts when the frame has none.
+const PartLayout& component_part(const BufferLayout& layout, std::uint32_t component_id);
 // The part holding a colour image: the only part, or the only 2D image part.
 const PartLayout& color_part(const BufferLayout& layout);
 

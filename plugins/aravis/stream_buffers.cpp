@@ -1,5 +1,7 @@
 #include "stream_buffers.h"
 
+#include <algorithm>
+
 #include "tilth/error.h"
 
 namespace tilth::aravis {
@@ -53,11 +55,15 @@ std::shared_ptr<StreamBuffers> StreamBuffers::create(ArvStream* stream, std::siz
 // this object alive).
 StreamBuffers::~StreamBuffers() { g_object_unref(stream_); }
 
-void StreamBuffers::lend(ArvBuffer* buffer, cv::Mat& pixels) {
+void StreamBuffers::lend(ArvBuffer* buffer, std::span<cv::Mat* const> pixels) {
   auto* slot = static_cast<Slot*>(const_cast<void*>(arv_buffer_get_user_data(buffer)));
-  if (slot == nullptr || pixels.u != nullptr) {
+  const bool owned = std::any_of(pixels.begin(), pixels.end(),
+                                 [](const cv::Mat* mat) { return mat->u != nullptr; });
+  if (slot == nullptr || owned || pixels.empty()) {
     give_back(buffer);
-    throw Error("internal: lending a buffer that is not this stream's, or pixels already owned");
+    throw Error(
+        "internal: lending a buffer that is not this stream's, to no pixels, or to "
+        "pixels already owned");
   }
   std::size_t size = 0;
   const void* data = arv_buffer_get_data(buffer, &size);
@@ -65,10 +71,10 @@ void StreamBuffers::lend(ArvBuffer* buffer, cv::Mat& pixels) {
   shared.data = shared.origdata = static_cast<uchar*>(const_cast<void*>(data));
   shared.size = size;
   shared.userdata = slot;
-  shared.refcount = 1;
+  shared.refcount = static_cast<int>(pixels.size());
   shared.urefcount = 0;
   slot->lender = shared_from_this();
-  pixels.u = &shared;
+  for (cv::Mat* mat : pixels) mat->u = &shared;
 }
 
 void StreamBuffers::give_back(ArvBuffer* buffer) { arv_stream_push_buffer(stream_, buffer); }

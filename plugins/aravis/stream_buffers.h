@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <arv.h>
@@ -22,9 +23,10 @@ class StreamBuffers : public std::enable_shared_from_this<StreamBuffers> {
   StreamBuffers(const StreamBuffers&) = delete;
   StreamBuffers& operator=(const StreamBuffers&) = delete;
 
-  // `pixels` (a header over memory inside `buffer`, a buffer popped from this stream)
-  // now owns `buffer`: it and every copy of it keep the buffer from the stream.
-  void lend(ArvBuffer* buffer, cv::Mat& pixels);
+  // `pixels` (headers over memory inside `buffer`, a buffer popped from this stream: one
+  // per part taken from it) now own `buffer` together: any of them or of their copies
+  // keeps the buffer from the stream.
+  void lend(ArvBuffer* buffer, std::span<cv::Mat* const> pixels);
   // Returns a popped buffer that is not lent (an incomplete frame, a dropped one).
   void give_back(ArvBuffer* buffer);
 
@@ -59,7 +61,13 @@ class PoppedBuffer {
   ArvBuffer* get() const { return buffer_; }
   explicit operator bool() const { return buffer_ != nullptr; }
   // See StreamBuffers::lend; the buffer is then no longer this object's to give back.
-  void lend_to(cv::Mat& pixels) { owner_->lend(std::exchange(buffer_, nullptr), pixels); }
+  void lend_to(std::span<cv::Mat* const> pixels) {
+    owner_->lend(std::exchange(buffer_, nullptr), pixels);
+  }
+  void lend_to(cv::Mat& pixels) {
+    cv::Mat* const one[] = {&pixels};
+    lend_to(one);
+  }
   void reset() {
     if (buffer_ != nullptr) owner_->give_back(std::exchange(buffer_, nullptr));
   }

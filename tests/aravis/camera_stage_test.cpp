@@ -206,6 +206,12 @@ TEST(AravisCamera, ASettingTheCameraRefusesNamesTheFeatureAndTheCamera) {
       {{{"features", {{"Width", 100000}}}}, "setting feature 'Width' of " + camera + " to 100000"},
       {{{"features", json::array({1})}},
        "parameter 'features': entry 0 must be an object with one member"},
+      {{{"intensity_component", "Intensity"}},
+       camera + " has no components (ComponentSelector), so it cannot stream component "
+                "'Intensity' beside its image"},
+      {{{"intensity_component", "Intensity"}, {"component", ""}},
+       "intensity_component 'Intensity' streams beside the range component, and component is "
+       "empty"},
   };
   for (const auto& test : cases) {
     try {

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include <arv.h>
@@ -21,6 +22,7 @@
 #include "frame_layout.h"
 #include "gobject_ptr.h"
 #include "stream_buffers.h"
+#include "tilth/error.h"
 
 namespace tilth::aravis {
 namespace {
@@ -156,35 +158,59 @@ gint input_buffers(ArvStream* stream) {
   return input;
 }
 
-TEST(MultiPartStream, TheRangePartOfAMultiPartFrameFromAravisIsWrappedWithoutCopying) {
-  testing::FakeCamera fake("127.0.0.18", "TILTH18");
-  fake.start();
-  GErrorSlot error;
-  GObjectPtr<ArvCamera> camera(arv_camera_new(fake.address().c_str(), error.out()));
-  error.check("opening the simulator");
-  arv_camera_gv_set_stream_options(camera.get(), ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
-  GObjectPtr<ArvStream> stream(
-      arv_camera_create_stream(camera.get(), nullptr, nullptr, error.out()));
-  error.check("creating the stream");
-  const auto buffers = StreamBuffers::create(stream.get(), 2, 4096);
-  ASSERT_EQ(input_buffers(stream.get()), 2);
+// A stream on the simulator's control connection, and a sender of GVSP packets to it.
+class MultiPartStream : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    fake_.start();
+    GErrorSlot error;
+    camera_.reset(arv_camera_new(fake_.address().c_str(), error.out()));
+    error.check("opening the simulator");
+    arv_camera_gv_set_stream_options(camera_.get(), ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
+    stream_.reset(arv_camera_create_stream(camera_.get(), nullptr, nullptr, error.out()));
+    error.check("creating the stream");
+    buffers_ = StreamBuffers::create(stream_.get(), 2, 4096);
+    ASSERT_EQ(input_buffers(stream_.get()), 2);
 
-  // The address the stream listens on (Aravis keeps ownership).
-  GSocketAddress* host =
-      arv_gv_device_get_interface_address(ARV_GV_DEVICE(arv_camera_get_device(camera.get())));
-  gchar* host_address =
-      g_inet_address_to_string(g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(host)));
-  GvspSender sender(fake.address(), host_address,
-                    arv_gv_stream_get_port(ARV_GV_STREAM(stream.get())));
-  g_free(host_address);
-  const std::vector<Part> parts = {
+    // The address the stream listens on (Aravis keeps ownership).
+    GSocketAddress* host =
+        arv_gv_device_get_interface_address(ARV_GV_DEVICE(arv_camera_get_device(camera_.get())));
+    gchar* host_address =
+        g_inet_address_to_string(g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(host)));
+    sender_.emplace(fake_.address(), host_address,
+                    arv_gv_stream_get_port(ARV_GV_STREAM(stream_.get())));
+    g_free(host_address);
+  }
+
+  // A blaze-101-like frame: intensity (component 1), range with padded rows (component
+  // 7), confidence (component 9), each part 8x4 pixels.
+  PoppedBuffer receive_blaze_frame(std::uint64_t block_id) {
+    sender_->send_multipart(block_id, 123456789, parts_);
+    return PoppedBuffer(buffers_, arv_stream_timeout_pop_buffer(stream_.get(), 1'000'000));
+  }
+
+  const std::vector<Part> parts_ = {
       part16(1, ARV_PIXEL_FORMAT_MONO_16, 1, 8, 4, 0, 1000),
       part16(5, ARV_PIXEL_FORMAT_COORD3D_C_16, 7, 8, 4, 6, 2000),  // rows padded by 6 bytes
       part16(9, kConfidence16, 9, 8, 4, 0, 3000),
   };
-  sender.send_multipart(42, 123456789, parts);
+  testing::FakeCamera fake_{"127.0.0.18", "TILTH18"};
+  GObjectPtr<ArvCamera> camera_;
+  GObjectPtr<ArvStream> stream_;
+  std::shared_ptr<StreamBuffers> buffers_;
+  std::optional<GvspSender> sender_;
+};
 
-  PoppedBuffer popped(buffers, arv_stream_timeout_pop_buffer(stream.get(), 1'000'000));
+void expect_values(const cv::Mat& gray, int first) {
+  ASSERT_EQ(gray.cols, 8);
+  ASSERT_EQ(gray.rows, 4);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 8; ++x) EXPECT_EQ(gray.at<std::uint16_t>(y, x), first + y * 8 + x);
+  }
+}
+
+TEST_F(MultiPartStream, TheRangePartOfAMultiPartFrameFromAravisIsWrappedWithoutCopying) {
+  PoppedBuffer popped = receive_blaze_frame(42);
   ASSERT_TRUE(popped) << "Aravis made no buffer of the packets";
   ASSERT_EQ(arv_buffer_get_status(popped.get()), ARV_BUFFER_STATUS_SUCCESS);
   EXPECT_EQ(arv_buffer_get_frame_id(popped.get()), 42u);
@@ -198,20 +224,53 @@ TEST(MultiPartStream, TheRangePartOfAMultiPartFrameFromAravisIsWrappedWithoutCop
   const PartLayout& range = tof_part(layout, 7u);
   cv::Mat gray = wrap_part(range, *find_format(tof_formats(), range.pixel_format));
   popped.lend_to(gray);
-  ASSERT_EQ(gray.cols, 8);
-  ASSERT_EQ(gray.rows, 4);
   EXPECT_EQ(gray.step[0], 8u * 2 + 6);
-  for (int y = 0; y < 4; ++y) {
-    for (int x = 0; x < 8; ++x) EXPECT_EQ(gray.at<std::uint16_t>(y, x), 2000 + y * 8 + x);
-  }
+  expect_values(gray, 2000);
   // The pixels are the buffer's own: the intensity part first, then the range part.
-  EXPECT_EQ(gray.data, gray.u->data + parts[0].bytes.size());
+  EXPECT_EQ(gray.data, gray.u->data + parts_[0].bytes.size());
 
   cv::Mat copy = gray;
   gray.release();
-  EXPECT_EQ(input_buffers(stream.get()), 1);  // the copy still holds the buffer
+  EXPECT_EQ(input_buffers(stream_.get()), 1);  // the copy still holds the buffer
   copy.release();
-  EXPECT_EQ(input_buffers(stream.get()), 2);  // back in the stream
+  EXPECT_EQ(input_buffers(stream_.get()), 2);  // back in the stream
+}
+
+// What aravis.tof_camera does with intensity_component: both parts of one capture, each
+// wrapped without copying, the buffer back in the stream once neither is held.
+TEST_F(MultiPartStream, TheIntensityAndRangeOfOneCaptureShareItsBufferUntilBothAreReleased) {
+  PoppedBuffer popped = receive_blaze_frame(43);
+  ASSERT_TRUE(popped) << "Aravis made no buffer of the packets";
+  const BufferLayout layout = layout_of(popped.get());
+  const ImageFormat& mono16 = *find_format(tof_formats(), ARV_PIXEL_FORMAT_MONO_16);
+  cv::Mat range =
+      wrap_part(tof_part(layout, 7u), *find_format(tof_formats(), ARV_PIXEL_FORMAT_COORD3D_C_16));
+  cv::Mat intensity = wrap_part(component_part(layout, 1u), mono16);
+  cv::Mat* const both[] = {&range, &intensity};
+  popped.lend_to(both);
+  expect_values(range, 2000);
+  expect_values(intensity, 1000);
+  EXPECT_EQ(intensity.data, intensity.u->data);  // the first part, at the buffer's start
+  EXPECT_EQ(range.u, intensity.u);
+
+  range.release();
+  EXPECT_EQ(input_buffers(stream_.get()), 1);  // the intensity still holds the buffer
+  cv::Mat kept = intensity;
+  intensity.release();
+  EXPECT_EQ(input_buffers(stream_.get()), 1);
+  kept.release();
+  EXPECT_EQ(input_buffers(stream_.get()), 2);  // back in the stream
+
+  EXPECT_THROW(component_part(layout, 4u), Error);  // no such component in the frame
+  try {
+    component_part(layout, 4u);
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "no part of the frame belongs to component 4 (part 0: component 1, " +
+                  describe_pixel_format(ARV_PIXEL_FORMAT_MONO_16) + ", 8x4; part 1: component 7, " +
+                  describe_pixel_format(ARV_PIXEL_FORMAT_COORD3D_C_16) +
+                  ", 8x4; part 2: component 9, 0x011000c7, 8x4)");
+  }
 }
 
 }  // namespace
