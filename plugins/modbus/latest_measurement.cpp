@@ -6,14 +6,18 @@ namespace tilth::modbus {
 
 void LatestMeasurement::update(std::uint64_t frame_id, const GroundDistance& distance,
                                Clock::time_point arrived, std::chrono::milliseconds capture_age) {
+  // A held distance is as old as the frame it was measured in.
+  const auto held_for = std::chrono::milliseconds(
+      distance.held ? static_cast<std::int64_t>(std::max(distance.held_ms, 0.0)) : 0);
   Measurement measurement{frame_id,
                           distance.valid,
+                          distance.valid && distance.held,
                           distance.valid ? InvalidCause::kNone : distance.cause,
                           distance.distance_mm,
                           distance.soil_fraction,
                           distance.confidence,
                           arrived,
-                          std::max(capture_age, std::chrono::milliseconds(0))};
+                          std::max(capture_age, std::chrono::milliseconds(0)) + held_for};
   std::lock_guard lock(mutex_);
   measurement_ = measurement;
   last_frame_ = arrived;
@@ -45,6 +49,7 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
       std::chrono::duration_cast<std::chrono::milliseconds>(now - measurement_->arrived);
   values.stale = since_arrival > stale_timeout_;
   values.valid = measurement_->valid && !values.stale && !last_frame_missing_;
+  values.held = values.valid && measurement_->held;
   values.cause = measurement_->cause;
   values.distance_mm = measurement_->distance_mm;
   values.soil_fraction = measurement_->soil_fraction;

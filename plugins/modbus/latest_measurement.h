@@ -37,6 +37,7 @@ class LatestMeasurement {
   struct Measurement {
     std::uint64_t frame_id = 0;
     bool valid = false;
+    bool held = false;
     InvalidCause cause = InvalidCause::kNone;
     double distance_mm = 0.0;
     double soil_fraction = 0.0;

@@ -74,7 +74,8 @@ RegisterBlock encode(const RegisterValues& values, WordOrder order) {
   put(block, kFrameCounter, split_words(static_cast<std::uint32_t>(values.frame_id), order));
   block[kStatus] = static_cast<std::uint16_t>(
       (values.valid ? kValid : 0) | (values.camera_ok ? kCameraOk : 0) | cause_bits(values.cause) |
-      (values.stale ? kStale : 0) | (values.pipeline_error ? kPipelineError : 0));
+      (values.stale ? kStale : 0) | (values.pipeline_error ? kPipelineError : 0) |
+      (values.valid && values.held ? kHeld : 0));
   block[kSoilFraction] =
       static_cast<std::uint16_t>(scaled(values.soil_fraction, 10000.0, 0, 10000));
   block[kConfidence] = static_cast<std::uint16_t>(scaled(values.confidence, 1000.0, 0, 1000));

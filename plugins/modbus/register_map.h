@@ -34,6 +34,7 @@ enum StatusBit : std::uint16_t {
   kPipelineError = 1u << 4,
   kImplausible = 1u << 5,    // not one surface, out of the rig's range, or low confidence
   kImageUnusable = 1u << 6,  // the colour image carries no information
+  kHeld = 1u << 7,           // valid, but an earlier frame's distance (estimation.temporal)
 };
 
 // Which of the two 16-bit words of a 32-bit value comes first (at the lower address).
@@ -46,6 +47,7 @@ WordOrder parse_word_order(std::string_view name);
 // What the registers say at one instant, before encoding.
 struct RegisterValues {
   bool valid = false;
+  bool held = false;  // the valid distance is an earlier frame's; age counts from that frame
   bool camera_ok = false;
   InvalidCause cause = InvalidCause::kNone;  // of the measurement shown
   bool stale = true;

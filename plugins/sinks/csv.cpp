@@ -30,7 +30,7 @@ namespace {
 
 constexpr std::string_view kHeader =
     "index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
-    "soil_pixels,spread_mm,confidence,latency_ms,truth_mm,tilth_version\n";
+    "soil_pixels,spread_mm,confidence,held_ms,latency_ms,truth_mm,tilth_version\n";
 
 // File `number` of a rotated series: the path itself, then "<stem>.<number><extension>".
 std::filesystem::path numbered(const std::filesystem::path& path, std::uint64_t number) {
@@ -79,16 +79,18 @@ class Csv final : public Sink {
       const auto& known = frame.input<GroundTruth>(kTruth);
       if (known.distance_mm) truth = format("%.3f", *known.distance_mm);
     }
+    const std::string held =
+        distance.valid && distance.held ? format("%.1f", distance.held_ms) : std::string();
     const std::string row =
-        format("%llu,%lld,%lld,%.3f,%d,%s,%.4f,%lld,%.3f,%.3f,%.3f,",
+        format("%llu,%lld,%lld,%.3f,%d,%s,%.4f,%lld,%.3f,%.3f,",
                static_cast<unsigned long long>(info.frame_id),
                static_cast<long long>(info.device_timestamp_ns),
                static_cast<long long>(info.host_timestamp_ns),
                distance.valid ? distance.distance_mm : std::nan(""), distance.valid ? 1 : 0,
                distance.valid ? "" : to_string(distance.cause).data(), distance.soil_fraction,
                static_cast<long long>(distance.soil_pixels), distance.spread_mm,
-               distance.confidence, latency_ms) +
-        truth + "," + std::string(version()) + "\n";
+               distance.confidence) +
+        held + format(",%.3f,", latency_ms) + truth + "," + std::string(version()) + "\n";
     if (file_ >= 0 && full_before(row)) {
       ++number_;
       close();  // when this throws, the next row still goes to the next file

@@ -121,6 +121,8 @@ void GroundDistance::invalidate(InvalidCause why, std::string reason) {
   invalid_reason = std::move(reason);
   distance_mm = 0.0;
   confidence = 0.0;
+  held = false;
+  held_ms = 0.0;
 }
 
 std::string GroundDistance::summary() const {
@@ -129,6 +131,7 @@ std::string GroundDistance::summary() const {
   out.precision(2);
   if (valid) {
     out << distance_mm << " mm";
+    if (held) out << " (held, " << held_ms << " ms old)";
   } else {
     out << "invalid (" << invalid_reason << ")";
   }

@@ -235,5 +235,28 @@ TEST_F(LatestMeasurementTest, TheCauseOfTheNewestMeasurementIsShown) {
   EXPECT_EQ(latest_.values_at(t0_).cause, InvalidCause::kNone);
 }
 
+// estimation.temporal's held distance: valid with the held bit, and as old as the frame
+// it was measured in, not as the frame that carried it.
+TEST_F(LatestMeasurementTest, AHeldDistanceSetsHeldAndCountsItsAgeFromItsOwnFrame) {
+  GroundDistance held = measured(518.25, true);
+  held.held = true;
+  held.held_ms = 66.7;
+  latest_.update(9, held, t0_, milliseconds(12));
+  const RegisterBlock block =
+      encode(latest_.values_at(t0_ + milliseconds(5)), WordOrder::kHighFirst);
+  EXPECT_EQ(block[kStatus], kValid | kCameraOk | kHeld);
+  EXPECT_EQ(block[kStatus], 0x0083);
+  EXPECT_EQ(block[kAgeMs], 12 + 66 + 5);  // capture to arrival, held, arrival to now
+  EXPECT_EQ(block[kDistanceHundredthsMm + 1], 51825);
+
+  latest_.update(10, measured(518.5, true), t0_ + milliseconds(33), milliseconds(12));
+  EXPECT_EQ(encode(latest_.values_at(t0_ + milliseconds(33)), WordOrder::kHighFirst)[kStatus],
+            kValid | kCameraOk);
+  // Held but gone stale: neither valid nor held.
+  latest_.update(11, held, t0_ + milliseconds(40), milliseconds(0));
+  EXPECT_EQ(encode(latest_.values_at(t0_ + milliseconds(400)), WordOrder::kHighFirst)[kStatus],
+            kStale);
+}
+
 }  // namespace
 }  // namespace tilth::modbus

@@ -19,7 +19,7 @@ with open(os.path.join(os.environ["TILTH_SOURCE_DIR"], "CMakeLists.txt")) as cma
     RELEASE = re.search(r"project\(Tilth VERSION ([0-9.]+)", cmake_lists.read()).group(1)
 
 HEADER = ("index,device_timestamp_ns,host_timestamp_ns,distance_mm,valid,cause,soil_fraction,"
-          "soil_pixels,spread_mm,confidence,latency_ms,truth_mm,tilth_version")
+          "soil_pixels,spread_mm,confidence,held_ms,latency_ms,truth_mm,tilth_version")
 FIELDS = HEADER.split(",")
 
 
@@ -94,9 +94,41 @@ class Rows(unittest.TestCase):
             self.assertEqual(row["soil_pixels"], str(1000 + i))
             self.assertEqual(row["spread_mm"], "1.500")
             self.assertEqual(row["confidence"], "%.3f" % (i / 100 + 0.005))
+            self.assertEqual(row["held_ms"], "")  # no estimation.temporal before the sink
             self.assertGreaterEqual(float(row["latency_ms"]), 0.0)
             self.assertEqual(row["truth_mm"], "")  # no truth input connected
             self.assertEqual(row["tilth_version"], RELEASE)
+
+    def test_a_held_distance_is_valid_with_its_age(self):
+        """estimation.temporal between the source and the sink holds the distance over each
+        invalid frame: that row shows the frame before's distance, with held_ms its age."""
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "run.csv")
+            graph = os.path.join(tmp, "graph.json")
+            with open(graph, "w") as f:
+                json.dump({"nodes": {
+                    "source": {"type": "testdistance.sequence",
+                               "params": {"frames": 20, "fps": 50, "invalid_every": 5}},
+                    "hold": {"type": "estimation.temporal", "params": {"max_hold_ms": 500}},
+                    "csv": {"type": "sinks.csv", "params": {"path": path}}},
+                    "edges": [["source.distance", "hold.distance"],
+                              ["hold.distance", "csv.distance"]]}, f)
+            result = subprocess.run(tilth_command(graph), capture_output=True, text=True,
+                                    timeout=30, env=tilth_env())
+            self.assertEqual(result.returncode, 0, result.stderr)
+            rows = rows_of(path)
+        self.assertEqual(len(rows), 20)
+        for i, row in enumerate(rows):
+            self.assertEqual(row["valid"], "1")
+            if (i + 1) % 5 != 0:
+                self.assertEqual(row["held_ms"], "")
+                self.assertEqual(row["distance_mm"], "%.3f" % round(518.23 + 0.37 * i, 2))
+                continue
+            self.assertEqual(row["distance_mm"], rows[i - 1]["distance_mm"])
+            # Capture times of frames 20 ms apart, each taken when the frame is produced.
+            since_ms = (int(row["host_timestamp_ns"]) - int(rows[i - 1]["host_timestamp_ns"])) / 1e6
+            self.assertAlmostEqual(float(row["held_ms"]), since_ms, delta=0.05)  # 1 decimal
+            self.assertGreater(float(row["held_ms"]), 10.0)
 
 
 class Rotation(unittest.TestCase):

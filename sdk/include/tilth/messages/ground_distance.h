@@ -38,6 +38,10 @@ struct GroundDistance : MessageOf<GroundDistance> {
   double confidence = 0.0;           // 0..1
   std::optional<double> tilt_x_deg;  // ground tilt, when a plane was fitted
   std::optional<double> tilt_y_deg;
+  // Set by estimation.temporal: the distance (valid) is an earlier frame's, held over a
+  // frame that had none or an outlier, measured held_ms before this frame's capture.
+  bool held = false;
+  double held_ms = 0.0;
 
   // Marks the measurement invalid for `cause`: distance and confidence 0, never a guess.
   void invalidate(InvalidCause why, std::string reason);

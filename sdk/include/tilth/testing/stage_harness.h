@@ -57,6 +57,11 @@ class TransformHarness {
     FrameInfo info;
     info.sequence = frame_id;
     info.frame_id = frame_id;
+    return run(std::move(inputs), info);
+  }
+  // The same, with the frame's capture times: for stages that keep time.
+  std::vector<Packet> run(std::vector<std::shared_ptr<const Message>> inputs,
+                          const FrameInfo& info) {
     std::vector<Packet> in(std::max(inputs.size(), descriptor_.inputs.size()));
     for (std::size_t port = 0; port < inputs.size(); ++port) {
       if (inputs[port] != nullptr) in[port] = Packet(info, std::move(inputs[port]));
