@@ -5,9 +5,10 @@
 //     "edges": [["a.out", "b.in"], {"from": "a.out", "to": "b.in"}],
 //     "inputs": {"raw": "a.in"}, "outputs": {"distance": "b.out"},
 //     "runtime": {"max_in_flight": 4, "when_full": "block", "on_error": "skip"} }
-// A node of the including file with the name of an included node replaces it when it
-// names a type, overrides only the parameters it lists otherwise, and removes it (with
-// its edges, inputs and outputs) when it is null.
+// An included file is looked for beside the including one, then among the shipped graphs
+// (share/tilth/graphs). A node of the including file with the name of an included node replaces it
+// when it names a type, overrides only the parameters it lists otherwise, and removes it (with its
+// edges, inputs and outputs) when it is null.
 #include "framework/graph_loader.h"
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <unordered_map>
 
 #include "framework/diagnostics.h"
+#include "framework/install_layout.h"
 #include "framework/nearest_names.h"
 #include "tilth/json_input.h"
 
@@ -290,8 +292,18 @@ class Loader {
           passed = json::object();
         }
       }
-      load(dir / entry["file"].get<std::string>(), nested_prefix, passed, where.child("file"));
+      load(included_file(dir, entry["file"].get<std::string>()), nested_prefix, passed,
+           where.child("file"));
     }
+  }
+
+  // Beside the including file; failing that, among the graphs Tilth ships, so that a
+  // machine's graph copied to /etc/tilth/ still includes cameras.json and the chain.
+  static fs::path included_file(const fs::path& dir, const std::string& name) {
+    const fs::path beside = dir / name;
+    if (fs::exists(beside) || fs::path(name).is_absolute()) return beside;
+    const fs::path shipped = shipped_data_dir() / "graphs" / name;
+    return fs::exists(shipped) ? shipped : beside;
   }
 
   void load_nodes(const json& document, const Location& root, const fs::path& dir,

@@ -6,6 +6,7 @@
 
 #include <boost/dll/shared_library.hpp>
 
+#include "framework/install_layout.h"
 #include "framework/nearest_names.h"
 #include "tilth/log.h"
 #include "tilth/plugin.h"
@@ -66,8 +67,7 @@ std::vector<fs::path> plugin_search_path(const fs::path& graph_dir) {
       start = end + 1;
     }
   }
-  dirs.emplace_back(TILTH_BUILD_PLUGIN_DIR);
-  dirs.emplace_back(TILTH_INSTALL_PLUGIN_DIR);
+  dirs.push_back(shipped_plugin_dir());
   return dirs;
 }
 

@@ -55,7 +55,8 @@ class StageRegistry {
 };
 
 // Where plugins are looked for, in order: the graph file's directory (when given), each
-// directory of TILTH_PLUGIN_PATH, the build tree's plugin directory, the installed one.
+// directory of TILTH_PLUGIN_PATH, the plugins shipped beside the executable
+// (shipped_plugin_dir()).
 std::vector<std::filesystem::path> plugin_search_path(const std::filesystem::path& graph_dir = {});
 
 // A plugin file name is tilth_<name>.so.

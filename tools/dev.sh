@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The two front-door commands (see README.md):
 #   bash tools/dev.sh demo   install what is missing, build, run the built-in demo graph
-#   bash tools/dev.sh test   install what is missing, build, run every test; every test
+#   bash tools/dev.sh test   install what is missing, build, run every test; install the
+#                            .deb packages into a bare Debian root; every test
 #                            again under ASan+UBSan; the threaded code under TSan; and each
 #                            fuzz target for TILTH_FUZZ_SECONDS (default 60) seconds
 #                            (docs/reliability.md)
@@ -47,6 +48,8 @@ if [ "$mode" = sanitize ]; then
 fi
 
 step ctest --preset default
+# The .deb packages installed with apt into a bare Debian root, and run there.
+step bash tests/packaging/deb_in_clean_root.sh build
 asan
 # The runtime, every parallel stage and the threaded serial stages under ThreadSanitizer.
 cmake --preset tsan >/dev/null

@@ -15,6 +15,8 @@ packages=(
   libmodbus-dev mbpoll python3-pymodbus python3-serial python3-serial-asyncio
   # recordings
   libzstd-dev liblz4-dev zlib1g-dev nodejs
+  # running as a systemd service; the packages (cpack) and their test in a bare root
+  libsystemd-dev systemd dpkg-dev debootstrap
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # the fuzz targets: clang with libFuzzer and its sanitizer runtimes

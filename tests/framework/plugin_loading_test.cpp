@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "framework/install_layout.h"
 #include "framework/stage_registry.h"
 #include "tilth/abi.h"
 #include "tilth/build_stamp.h"
@@ -146,11 +147,15 @@ TEST(PluginLoading, SearchPathOrder) {
   setenv("TILTH_PLUGIN_PATH", "/opt/a:/opt/b", 1);
   const auto dirs = plugin_search_path("/graphs");
   unsetenv("TILTH_PLUGIN_PATH");
-  ASSERT_EQ(dirs.size(), 5u);
+  ASSERT_EQ(dirs.size(), 4u);
   EXPECT_EQ(dirs[0], "/graphs");
   EXPECT_EQ(dirs[1], "/opt/a");
   EXPECT_EQ(dirs[2], "/opt/b");
+  // The test runs from the build tree's bin/, laid out as an installed tree.
   EXPECT_EQ(dirs[3], TILTH_BUILD_PLUGIN_DIR);
+  EXPECT_EQ(shipped_data_dir() / "graphs" / "demo.json",
+            fs::path(TILTH_BUILD_DIR) / "share/tilth/graphs/demo.json");
+  EXPECT_TRUE(fs::is_regular_file(shipped_data_dir() / "graphs" / "demo.json"));
   EXPECT_TRUE(is_plugin_file_name("tilth_sinks.so"));
   EXPECT_FALSE(is_plugin_file_name("libtilth_sdk.so"));
 }

@@ -9,7 +9,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 
-cmake --install "$build" --component sdk --prefix "$scratch/prefix" >/dev/null
+# As the packages tilth-dev and the tilth it depends on (the SDK's shared library) install it.
+for component in runtime sdk; do
+  cmake --install "$build" --component $component --prefix "$scratch/prefix" >/dev/null
+done
 cmake -S "$here" -B "$scratch/build" -G Ninja -DCMAKE_PREFIX_PATH="$scratch/prefix" \
   -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$scratch/build" >/dev/null

@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "command_line.h"
+#include "framework/install_layout.h"
 #include "variant_specs.h"
 
 namespace tilth::ab {
@@ -57,7 +58,7 @@ fs::path default_chain(const cli::CommandLine& line) {
     if (!fs::is_regular_file(*chain)) throw UsageError("--chain " + *chain + ": no such file");
     return fs::absolute(*chain).lexically_normal();
   }
-  return fs::path(TILTH_SOURCE_GRAPHS_DIR) / "measurement-chain.json";
+  return shipped_data_dir() / "graphs" / "measurement-chain.json";
 }
 
 }  // namespace

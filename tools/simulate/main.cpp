@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "data_loss_report.h"
 #include "framework/diagnostics.h"
+#include "framework/install_layout.h"
 #include "in_process_graph.h"
 #include "output_path.h"
 #include "stop_signals.h"
@@ -109,19 +110,21 @@ int main(int argc, char** argv) {
                                     format == "mcap" ? tilth::tools::RecordingKind::kMcapFile
                                                      : tilth::tools::RecordingKind::kImageFolder,
                                     overwrite);
+    const std::string calibration =
+        (tilth::shipped_data_dir() / "calib" / "paper_rig.calib.json").string();
     tilth::tools::InProcessGraph graph("tilth simulate");
-    graph.add_node("scene", "synthetic.scene", {{"calibration", TILTH_DEFAULT_CALIBRATION}});
+    graph.add_node("scene", "synthetic.scene", {{"calibration", calibration}});
     if (format == "mcap") {
       // Paced like a camera, the writer keeps up as a live recording does (see
       // mcap.writer's when_behind); otherwise every chunk is compressed.
       graph.add_node("writer", "mcap.writer",
                      {{"path", output.string()},
-                      {"calibration", TILTH_DEFAULT_CALIBRATION},
+                      {"calibration", calibration},
                       {"when_behind", live ? "store" : "wait"}});
     } else {
       graph.add_node("writer", "recording.image_folder_writer",
                      {{"path", output.string()},
-                      {"calibration", TILTH_DEFAULT_CALIBRATION},
+                      {"calibration", calibration},
                       {"overwrite", overwrite},
                       {"description", command_text(argc, argv)}});
     }

@@ -29,8 +29,8 @@ commands:
 
 'tilth --version' prints the release and what it was built with. Any other COMMAND runs the
 program tilth-COMMAND found next to tilth or on PATH.
-Plugins are searched next to the graph file, in TILTH_PLUGIN_PATH, and in the build
-and install plugin directories.
+Plugins are searched next to the graph file, in TILTH_PLUGIN_PATH, and in
+../lib/tilth/plugins from this program's directory.
 )";
 
 void print_usage() {

@@ -1,6 +1,6 @@
 // `tilth run`: runs a graph until its sources end, --frames is reached, or SIGINT /
 // SIGTERM asks it to stop (frames in flight finish, sinks flush, exit code 0; 3 when a
-// stage lost data).
+// stage lost data). Started by systemd (Type=notify), it reports readiness and progress.
 #include <csignal>
 #include <iostream>
 
@@ -13,6 +13,8 @@
 #include "framework/graph_session.h"
 #include "framework/runtime.h"
 #include "graph_options.h"
+#include "journal_log.h"
+#include "service_notifier.h"
 #include "status_reporter.h"
 #include "stop_signals.h"
 #include "tilth/log.h"
@@ -56,6 +58,7 @@ int run_command(int argc, char** argv) {
     std::cerr << kUsage;
     return kExitUsage;
   }
+  if (stderr_is_journal()) log_to_journal();
   if (line.flag("--verbose")) set_log_level(LogLevel::kDebug);
   if (line.flag("--quiet")) set_log_level(LogLevel::kWarning);
   RunLimits limits;
@@ -79,7 +82,12 @@ int run_command(int argc, char** argv) {
   log(LogLevel::kInfo, "run", "running " + file);
   RunResult result;
   {
-    const tools::StopSignalWatcher watcher("run", [&runtime] { runtime->stop(); });
+    std::optional<ServiceNotifier> service;
+    if (ServiceNotifier::wanted()) service.emplace([&runtime] { return runtime->metrics(); });
+    const tools::StopSignalWatcher watcher("run", [&runtime, &service] {
+      if (service) service->stopping();
+      runtime->stop();
+    });
     std::optional<StatusReporter> reporter;
     if (!line.flag("--quiet")) {
       reporter.emplace([&runtime] { return runtime->metrics(); }, isatty(STDERR_FILENO) == 1);
