@@ -132,6 +132,51 @@ class MachineGraphs(unittest.TestCase):
             plc.kill()
             plc.wait()
 
+    def test_the_served_distance_follows_a_soil_step_one_frame_later(self):
+        """The seeder graph over the `steps` preset where the soil drops 8 mm (frames 72-85):
+        the CSV of estimation.temporal's output beside one of the estimator's. The jump's
+        first frame is held (the distance before it, with its age), the second confirms it
+        and is served as measured; every other frame is served as measured."""
+        tmp = tempfile.mkdtemp(prefix="tilth-steps-")
+        self.addCleanup(shutil.rmtree, tmp, ignore_errors=True)
+        graph = os.path.join(tmp, "steps.json")
+        measured_csv, served_csv = os.path.join(tmp, "measured.csv"), os.path.join(tmp, "served.csv")
+        with open(graph, "w") as f:
+            f.write('{"include": ["%s"], "nodes": {"plc": null, "measured": {"type": "sinks.csv",'
+                    ' "params": {"path": "%s"}}}, "edges": [["chain/estimate.distance",'
+                    ' "measured.distance"]]}' % (os.path.join(GRAPHS, "simulated", "seeder.json"),
+                                                 measured_csv))
+        # The simulator renders a moving ground at about a frame a second here, far slower
+        # than the cameras; the hold is lengthened to match (its timing has unit tests).
+        done = subprocess.run(
+            [TILTH, "run", graph, "--quiet", "--var", "log=" + served_csv,
+             "--set", "camera.preset=steps", "--set", "camera.first_frame=72",
+             "--set", "camera.frames=14", "--set", "hold.max_hold_ms=10000",
+             "--set", "runtime.when_full=block"], capture_output=True, text=True, timeout=300)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(measured_csv, newline="") as f:
+            measured = list(csv.DictReader(f))
+        with open(served_csv, newline="") as f:
+            served = list(csv.DictReader(f))
+        self.assertEqual(len(measured), 14)
+        self.assertEqual([r["index"] for r in served], [r["index"] for r in measured])
+        self.assertTrue(all(r["valid"] == "1" for r in measured + served))
+        mm = [float(r["distance_mm"]) for r in measured]
+        jumps = [i for i in range(1, len(mm)) if abs(mm[i] - mm[i - 1]) > 3.0]
+        self.assertEqual(len(jumps), 1, mm)  # the 8 mm drop, seen over 3 mm in one frame
+        jump = jumps[0]
+        self.assertLess(mm[jump] - mm[jump - 1], -5.0)
+        for i, (m, s) in enumerate(zip(measured, served)):
+            if i == jump:
+                self.assertEqual(s["distance_mm"], measured[i - 1]["distance_mm"])
+                self.assertGreater(float(s["held_ms"]), 0.0)
+            else:
+                self.assertEqual(s["distance_mm"], m["distance_mm"], i)
+                self.assertEqual(s["held_ms"], "", i)
+        # Once followed, the served distance is the new soil's, within the seeder's bound.
+        self.assertAlmostEqual(float(served[jump + 1]["distance_mm"]),
+                               float(served[jump + 1]["truth_mm"]), delta=TOLERANCE_MM["seeder"])
+
 
 if __name__ == "__main__":
     unittest.main()
