@@ -11,6 +11,8 @@ packages=(
   libopencv-dev libeigen3-dev
   # cameras (GigE Vision) and the camera simulator used by the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev iproute2
+  # tilth doctor's test: packet loss caused in the simulated cameras' network
+  nftables
   # machine outputs and their real peers in tests
   libmodbus-dev mbpoll python3-pymodbus python3-serial python3-serial-asyncio
   # recordings

@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "device_list.h"
+#include "aravis/device_list.h"
 
 namespace tilth::aravis {
 namespace {

@@ -12,9 +12,9 @@
 
 #include <arv.h>
 
+#include "aravis/gobject_ptr.h"
 #include "camera_settings.h"
 #include "camera_setup.h"
-#include "gobject_ptr.h"
 #include "stream_buffers.h"
 #include "tilth/log.h"
 

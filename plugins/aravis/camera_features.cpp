@@ -3,7 +3,7 @@
 #include <cmath>
 #include <functional>
 
-#include "gobject_ptr.h"
+#include "aravis/gobject_ptr.h"
 
 namespace tilth::aravis {
 namespace {

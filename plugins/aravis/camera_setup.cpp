@@ -2,8 +2,8 @@
 
 #include <sstream>
 
+#include "aravis/gobject_ptr.h"
 #include "camera_features.h"
-#include "gobject_ptr.h"
 
 namespace tilth::aravis {
 namespace {

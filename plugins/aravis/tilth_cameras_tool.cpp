@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "aravis/device_list.h"
+#include "aravis/gobject_ptr.h"
 #include "camera_features.h"
-#include "device_list.h"
-#include "gobject_ptr.h"
 
 namespace {
 

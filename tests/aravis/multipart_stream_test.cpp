@@ -18,9 +18,9 @@
 #include <arv.h>
 #include <gtest/gtest.h>
 
+#include "aravis/gobject_ptr.h"
 #include "fake_camera.h"
 #include "frame_layout.h"
-#include "gobject_ptr.h"
 #include "stream_buffers.h"
 #include "tilth/error.h"
 

@@ -24,7 +24,7 @@ class HelpAndInspection(unittest.TestCase):
             self.assertEqual(result.returncode, 0, command)
             self.assertIn("usage: tilth " + command, result.stdout)
             self.assertEqual(tilth(command, "-h").stdout, result.stdout, command)
-        for command in ["simulate", "recording", "ab", "train-segmenter", "calibrate"]:
+        for command in ["simulate", "recording", "ab", "train-segmenter", "calibrate", "doctor"]:
             result = tilth(command, "-h")
             self.assertEqual(result.returncode, 0, (command, result.stderr))
             self.assertIn("usage: tilth " + command, result.stdout)

@@ -39,7 +39,7 @@ class InstalledTree(unittest.TestCase):
         return os.path.join(self.prefix, *parts)
 
     def test_the_layout_of_an_installed_tree(self):
-        for program in ["tilth", "tilth-ab", "tilth-calibrate", "tilth-cameras",
+        for program in ["tilth", "tilth-ab", "tilth-calibrate", "tilth-cameras", "tilth-doctor",
                         "tilth-recording", "tilth-simulate", "tilth-train-segmenter"]:
             self.assertTrue(os.access(self.installed("bin", program), os.X_OK), program)
         plugins = sorted(os.listdir(self.installed("lib", "tilth", "plugins")))

@@ -1,4 +1,4 @@
-#include "device_list.h"
+#include "aravis/device_list.h"
 
 #include <arpa/inet.h>
 
