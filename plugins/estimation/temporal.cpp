@@ -10,8 +10,8 @@
 //   invalid ──► held while the track is younger than max_hold_ms, else passed on as it is
 //
 // Times are the frames' host capture times. A held distance is valid, with held set and
-// held_ms its age at this frame; past max_hold_ms the track ends and the next valid
-// distance starts a new one, whatever it is.
+// held_ms its age at this frame; past max_hold_ms, or at a capture time before the
+// track's last, the track ends and the next valid distance starts a new one, whatever it is.
 //
 //   "filter": {"type": "estimation.temporal",
 //              "params": {"max_hold_ms": 200, "outlier_mm": 3, "confirm_frames": 2}}
@@ -45,7 +45,11 @@ class Temporal final : public Transform {
   void process(Frame& frame) override {
     const GroundDistance& in = frame.input<GroundDistance>(0);
     const std::int64_t now_ns = frame.info().host_timestamp_ns;
-    if (track_ && now_ns - track_->accepted_ns > max_hold_ns_) track_.reset();
+    // Past max_hold_ms, or before the track's last frame (a replay that loops, a clock set
+    // back), the track ends.
+    if (track_ && (now_ns < track_->accepted_ns || now_ns - track_->accepted_ns > max_hold_ns_)) {
+      track_.reset();
+    }
 
     if (!in.valid) {
       candidates_.clear();

@@ -47,14 +47,18 @@ class TemporalFilter {
     FrameInfo info;
     info.sequence = info.frame_id = frames_;
     info.host_timestamp_ns =
-        1'700'000'000'000'000'000 + static_cast<std::int64_t>(frames_) * kPeriodNs;
+        1'700'000'000'000'000'000 + static_cast<std::int64_t>(frames_) * kPeriodNs + shift_ns_;
     ++frames_;
     return stage_.run({std::make_shared<GroundDistance>(in)}, info)[0].get<GroundDistance>();
   }
 
+  // Moves the capture clock: a replay that loops, a clock set back.
+  void shift_clock(std::int64_t ns) { shift_ns_ += ns; }
+
  private:
   TransformHarness stage_;
   std::uint64_t frames_ = 0;
+  std::int64_t shift_ns_ = 0;
 };
 
 // The soil under the tool point along the pass: 518 mm, 524 from frame 40, 519 from 80.
@@ -133,6 +137,23 @@ TEST(Temporal, HoldsOverAShortGapWithItsAgeAndGivesUpAfterMaxHold) {
   out = filter.next(valid_at(540.0));
   EXPECT_FALSE(out.held);
   EXPECT_DOUBLE_EQ(out.distance_mm, 540.0);
+}
+
+TEST(Temporal, ACaptureTimeBeforeTheTracksLastEndsTheTrack) {
+  TemporalFilter filter;
+  filter.next(valid_at(518.0));
+  filter.shift_clock(-1'000'000'000);
+  // Not held with a negative age: passed on invalid, with its own cause.
+  const GroundDistance gap = filter.next(invalid());
+  EXPECT_FALSE(gap.valid);
+  EXPECT_FALSE(gap.held);
+  EXPECT_EQ(gap.cause, InvalidCause::kTooLittleSoil);
+  // The next distance starts a new track, however far from the old one.
+  const GroundDistance restart = filter.next(valid_at(530.0));
+  EXPECT_TRUE(restart.valid);
+  EXPECT_FALSE(restart.held);
+  EXPECT_DOUBLE_EQ(restart.distance_mm, 530.0);
+  EXPECT_DOUBLE_EQ(restart.held_ms, 0.0);
 }
 
 TEST(Temporal, MaxHoldZeroNeverHolds) {

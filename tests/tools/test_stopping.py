@@ -4,6 +4,7 @@ preloaded library (early_thread_preload.cpp), as OpenCV's, oneTBB's or GLib's st
 constructors start them: the first signal stops the tool cleanly (exit code 0, the CSV
 ends with a whole row, the MCAP file has its summary), a second exits at once with 130."""
 import ctypes
+import glob
 import json
 import os
 import re
@@ -261,19 +262,27 @@ class Recordings(unittest.TestCase):
                         self.assertTrue(os.path.isfile(os.path.join(output, fields[column])), row)
 
     def test_a_second_signal_exits_at_once_with_130(self):
-        for args in (["simulate", "out.mcap", "--calibration", self.rig, "--preset", "flat",
-                      "--frames", 100000],
-                     ["recording", "import", self.folder, "out.mcap"]):
-            with self.subTest(tool=args[0]), tempfile.TemporaryDirectory() as tmp:
-                args = [os.path.join(tmp, a) if a == "out.mcap" else a for a in args]
-                output = os.path.join(tmp, "out.mcap")
+        # import and export hold a scratch folder (export a calibration file in it): gone
+        # too, though no destructor runs.
+        scratch = os.path.join(tempfile.gettempdir(), "tilth-recording-*")
+        before = set(glob.glob(scratch))
+        for args, output, written in (
+                (["simulate", "out.mcap", "--calibration", self.rig, "--preset", "flat",
+                  "--frames", 100000], "out.mcap", lambda path: file_size(path) > 1_000_000),
+                (["recording", "import", self.folder, "out.mcap"], "out.mcap",
+                 lambda path: file_size(path) > 1_000_000),
+                (["recording", "export", self.mcap, "out"], "out",
+                 lambda path: count_lines(os.path.join(path, "frames.csv")) > 10)):
+            with self.subTest(tool=" ".join(args[:2])), tempfile.TemporaryDirectory() as tmp:
+                output = os.path.join(tmp, output)
+                args = [output if a == os.path.basename(output) else a for a in args]
                 tool = Tool(tmp, *args)
-                tool.wait_for(lambda: file_size(output) > 1_000_000, "a written chunk")
+                tool.wait_for(lambda: written(output), "written output")
                 tool.signal(signal.SIGTERM)
                 tool.signal(signal.SIGINT)
                 self.assertEqual(tool.wait(), 130, tool.stderr())
                 self.assertIn(SECOND_SIGNAL, tool.stderr())
-
+                self.assertEqual(set(glob.glob(scratch)) - before, set())
 
 if __name__ == "__main__":
     unittest.main()

@@ -1,6 +1,7 @@
 #include "stop_signals.h"
 
 #include <fcntl.h>
+#include <limits.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,6 +27,21 @@ static_assert(std::atomic<int>::is_always_lock_free, "used in a signal handler")
 char second_signal_message[256];
 std::size_t second_signal_length = 0;
 
+// ScratchPath's registrations: a slot is written while its flag is clear, then flagged.
+char scratch_paths[ScratchPath::kScratchPaths][PATH_MAX];
+std::atomic<bool> scratch_taken[ScratchPath::kScratchPaths];
+static_assert(std::atomic<bool>::is_always_lock_free, "used in a signal handler");
+
+// Files first, then the folders they were in.
+void remove_scratch_paths() {
+  for (int i = 0; i < ScratchPath::kScratchPaths; ++i) {
+    if (scratch_taken[i].load()) ::unlink(scratch_paths[i]);
+  }
+  for (int i = 0; i < ScratchPath::kScratchPaths; ++i) {
+    if (scratch_taken[i].load()) ::rmdir(scratch_paths[i]);
+  }
+}
+
 void make_pipe() {
   std::call_once(pipe_made, [] {
     if (::pipe2(signal_pipe, O_CLOEXEC) != 0 || ::fcntl(signal_pipe[1], F_SETFL, O_NONBLOCK) != 0) {
@@ -34,10 +50,11 @@ void make_pipe() {
   });
 }
 
-// Async-signal-safe: an atomic, write(2) and _exit(2) only.
+// Async-signal-safe: atomics, write(2), unlink(2), rmdir(2) and _exit(2) only.
 void on_stop_signal(int signal) {
   const int saved_errno = errno;
   if (signals_received.fetch_add(1) > 0) {
+    remove_scratch_paths();
     (void)!::write(STDERR_FILENO, second_signal_message, second_signal_length);
     ::_exit(130);
   }
@@ -76,6 +93,23 @@ void install_stop_handlers(const std::string& tool) {
   }
   ::pthread_sigmask(SIG_UNBLOCK, &unblock, nullptr);
 }
+
+ScratchPath::ScratchPath(const std::filesystem::path& path) : slot_(-1) {
+  static std::mutex registering;
+  std::lock_guard lock(registering);
+  const std::string text = path.string();
+  if (text.size() >= PATH_MAX) throw Error(text + ": path too long for a scratch path");
+  for (int i = 0; i < kScratchPaths && slot_ < 0; ++i) {
+    if (scratch_taken[i].load()) continue;
+    std::memcpy(scratch_paths[i], text.c_str(), text.size() + 1);
+    scratch_taken[i].store(true);
+    slot_ = i;
+  }
+  if (slot_ < 0)
+    throw Error(text + ": more than " + std::to_string(kScratchPaths) + " scratch paths at once");
+}
+
+ScratchPath::~ScratchPath() { scratch_taken[slot_].store(false); }
 
 StopSignalWatcher::StopSignalWatcher(std::string tool, std::function<void()> stop)
     : tool_(std::move(tool)), stop_(std::move(stop)) {

@@ -5,6 +5,7 @@
 // stop.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <thread>
@@ -31,6 +32,23 @@ class StopSignalWatcher {
   const std::string tool_;
   const std::function<void()> stop_;
   std::thread thread_;
+};
+
+// A scratch file, or a folder once its files are gone, that is removed even when a second
+// stop signal exits at once, without destructors: the handler unlinks it (unlink(2) and
+// rmdir(2) are async-signal-safe). The owner removes it itself on a normal exit and
+// ends the registration with this object. At most kScratchPaths at a time.
+class ScratchPath {
+ public:
+  static constexpr int kScratchPaths = 16;
+
+  explicit ScratchPath(const std::filesystem::path& path);  // throws when all are taken
+  ~ScratchPath();
+  ScratchPath(const ScratchPath&) = delete;
+  ScratchPath& operator=(const ScratchPath&) = delete;
+
+ private:
+  int slot_;
 };
 
 }  // namespace tilth::tools

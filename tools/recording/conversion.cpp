@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <memory>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +12,7 @@
 #include "mcap/mcap_reader.h"
 #include "mcap/recording_layout.h"
 #include "output_path.h"
+#include "stop_signals.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 
@@ -19,7 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// A private folder under the system's temporary directory, removed with its contents.
+// A private folder under the system's temporary directory, removed with its contents,
+// also when a second stop signal exits at once.
 class TemporaryFolder {
  public:
   TemporaryFolder() {
@@ -28,6 +32,7 @@ class TemporaryFolder {
       throw Error("cannot create a temporary folder like " + pattern);
     }
     path_ = pattern;
+    scratch_.push_back(std::make_unique<ScratchPath>(path_));
   }
   ~TemporaryFolder() {
     std::error_code ignored;
@@ -36,8 +41,9 @@ class TemporaryFolder {
   TemporaryFolder(const TemporaryFolder&) = delete;
   TemporaryFolder& operator=(const TemporaryFolder&) = delete;
 
-  fs::path write(const std::string& name, const std::string& text) const {
+  fs::path write(const std::string& name, const std::string& text) {
     const fs::path file = path_ / name;
+    scratch_.push_back(std::make_unique<ScratchPath>(file));
     std::ofstream out(file, std::ios::binary);
     out << text;
     if (!out) throw Error(file.string() + ": cannot write");
@@ -46,6 +52,7 @@ class TemporaryFolder {
 
  private:
   fs::path path_;
+  std::vector<std::unique_ptr<ScratchPath>> scratch_;
 };
 
 RunResult run_conversion(InProcessGraph& graph, const std::string& what) {
@@ -62,7 +69,7 @@ void connect_recording_ports(InProcessGraph& graph) {
 
 // The calibration file that recording.json names, or its inline object written to
 // `scratch`; the rest of recording.json is the source stage's to check.
-fs::path folder_calibration(const fs::path& folder, const TemporaryFolder& scratch) {
+fs::path folder_calibration(const fs::path& folder, TemporaryFolder& scratch) {
   const fs::path file = folder / "recording.json";
   const json recording =
       parse_json(read_json_text(file, "(is this an image-folder recording?)"), file.string());
@@ -85,7 +92,7 @@ RunResult export_to_folder(const fs::path& mcap_file, const fs::path& folder,
                            const ConversionOptions& options) {
   check_apart(mcap_file, folder);
   check_output_path(folder, RecordingKind::kImageFolder, options.overwrite);
-  const TemporaryFolder scratch;
+  TemporaryFolder scratch;
   fs::path calibration;
   {
     mcap::McapReader reader(mcap_file);
@@ -114,7 +121,7 @@ RunResult import_from_folder(const fs::path& folder, const fs::path& mcap_file,
                              const ConversionOptions& options) {
   check_apart(folder, mcap_file);
   check_output_path(mcap_file, RecordingKind::kMcapFile, options.overwrite);
-  const TemporaryFolder scratch;
+  TemporaryFolder scratch;
   InProcessGraph graph("tilth recording import");
   graph.add_node("player", "recording.image_folder",
                  {{"path", folder.string()}, {"on_missing", "stop"}, {"host_time", "recorded"}});
