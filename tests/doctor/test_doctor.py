@@ -3,7 +3,8 @@ own: two simulated cameras in a network namespace (10.77.0.11, .12), joined to t
 a veth pair (10.77.0.1/24), as cameras on a NIC; a real Modbus TCP server (pymodbus) as the
 PLC. Then the failures the test can cause: an MTU below the cameras' packet size, packet
 loss (nftables dropping 1 in 20 of the cameras' stream packets), a closed PLC port, a
-camera that is not there, too little free disk."""
+camera that is not there, addresses off the host's subnets or the host's own, too little
+free disk."""
 import json
 import os
 import signal
@@ -165,6 +166,17 @@ class Doctor(unittest.TestCase):
         self.assertIn("Connection refused", plc["detail"])
         self.assertEqual(checks["free disk"]["verdict"], "failed")
         self.assertIn("wanted 1024000000 MiB", checks["free disk"]["detail"])
+
+    def test_addresses_off_the_subnet_or_the_hosts_own_fail(self):
+        code, checks = self.doctor("--camera", "10.78.0.5", "--camera", HOST_ADDRESS,
+                                   "--seconds", "1", "--min-free-gb", "0")
+        self.assertEqual(code, 1)
+        off = checks["camera 10.78.0.5: address"]
+        self.assertEqual((off["verdict"], off["detail"]),
+                         ("failed", "on no subnet of this host's interfaces"))
+        own = checks[f"camera {HOST_ADDRESS}: address"]
+        self.assertEqual(own["verdict"], "failed")
+        self.assertIn(f"the host's own interface {HOST_SIDE} has this address", own["detail"])
 
     def test_text_lines_and_usage(self):
         done = subprocess.run([TILTH, "doctor", "--camera", CAMERAS[0], "--seconds", "1",
