@@ -18,7 +18,7 @@ packages=(
   # recordings
   libzstd-dev liblz4-dev zlib1g-dev nodejs
   # running as a systemd service; the packages (cpack) and their test in a bare root
-  libsystemd-dev systemd dpkg-dev debootstrap
+  libsystemd-dev systemd dpkg-dev file debootstrap
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # the fuzz targets: clang with libFuzzer and its sanitizer runtimes

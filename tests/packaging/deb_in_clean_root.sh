@@ -7,8 +7,9 @@
 set -euo pipefail
 build=$(cd "${1:?usage: deb_in_clean_root.sh BUILD_DIR}" && pwd)
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/tilth/bookworm-minbase.tar
-mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1)
-mirror=${mirror:-$(awk '/^deb /{print $2; exit}' /etc/apt/sources.list 2>/dev/null)}
+# This host's Debian mirror (deb822 sources or sources.list), else Debian's own.
+mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1 || true)
+[ -n "$mirror" ] || mirror=$(awk '/^deb /{print $2; exit}' /etc/apt/sources.list 2>/dev/null || true)
 mirror=${mirror:-http://deb.debian.org/debian}
 
 root=$(mktemp -d /tmp/tilth-deb-root.XXXXXX)

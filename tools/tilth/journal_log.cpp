@@ -2,11 +2,16 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <string>
 
 #include <sys/stat.h>
+#include <sys/uio.h>
 #include <syslog.h>
 
+// Without CODE_FILE= and friends: they would name this file, not where a line came from,
+// and __FILE__ may be an absolute build path.
+#define SD_JOURNAL_SUPPRESS_LOCATION
 #include <systemd/sd-journal.h>
 
 #include "tilth/log.h"
@@ -43,14 +48,20 @@ bool stderr_is_journal() {
 
 void log_to_journal() {
   set_log_handler([](LogLevel level, std::string_view where, std::string_view message) {
-    const std::string node(where);
-    const std::string text(message);
-    const int sent = sd_journal_send("MESSAGE=%s: %s", node.c_str(), text.c_str(), "PRIORITY=%d",
-                                     priority_of(level), "TILTH_NODE=%s", node.c_str(),
-                                     "SYSLOG_IDENTIFIER=tilth", nullptr);
-    if (sent < 0) {
-      std::fprintf(stderr, "%s: %s: %s\n", std::string(to_string(level)).c_str(), node.c_str(),
-                   text.c_str());
+    const std::string fields[] = {
+        "MESSAGE=" + std::string(where) + ": " + std::string(message),
+        "PRIORITY=" + std::to_string(priority_of(level)),
+        "TILTH_NODE=" + std::string(where),
+        "SYSLOG_IDENTIFIER=tilth",
+    };
+    iovec entry[std::size(fields)];
+    for (std::size_t i = 0; i < std::size(fields); ++i) {
+      entry[i] = {const_cast<char*>(fields[i].data()), fields[i].size()};
+    }
+    if (sd_journal_sendv(entry, static_cast<int>(std::size(fields))) < 0) {
+      std::fprintf(stderr, "%s: %.*s: %.*s\n", std::string(to_string(level)).c_str(),
+                   static_cast<int>(where.size()), where.data(), static_cast<int>(message.size()),
+                   message.data());
     }
   });
 }
