@@ -31,7 +31,9 @@ def sh(*args, check=True):
 
 
 def in_namespace(*args, check=True):
-    return sh("ip", "netns", "exec", NAMESPACE, *args, check=check)
+    # nsenter enters only the network namespace: `ip netns exec` also remounts /sys, which
+    # a chroot (a clean root's test run) refuses.
+    return sh("nsenter", "--net=/run/netns/" + NAMESPACE, *args, check=check)
 
 
 def set_mtu(mtu):
@@ -54,7 +56,7 @@ class Doctor(unittest.TestCase):
         in_namespace("ip", "link", "set", CAMERA_SIDE, "up")
         in_namespace("ip", "link", "set", "lo", "up")
         cls.cameras = [subprocess.Popen(
-            ["ip", "netns", "exec", NAMESPACE, "arv-fake-gv-camera-0.8", "-i", address,
+            ["nsenter", "--net=/run/netns/" + NAMESPACE, "arv-fake-gv-camera-0.8", "-i", address,
              "-s", "DOCTOR%d" % i], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             for i, address in enumerate(CAMERAS)]
         cls.plc_port = free_port()
