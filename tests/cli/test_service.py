@@ -77,20 +77,23 @@ class Service:
 class Notifications(unittest.TestCase):
     def test_ready_watchdog_and_stopping_while_frames_flow(self):
         with tempfile.TemporaryDirectory() as directory:
-            service = Service(directory, demo(20), watchdog_ms=400)
+            service = Service(directory, demo(20), watchdog_ms=1000)
             try:
                 service.receive_until_ready()
-                service.receive_for(2.6)
+                service.receive_for(3.0)
             finally:
                 code, stderr = service.finish()
             self.assertEqual(code, 0, stderr)
             ready = service.times("READY=1")
             self.assertEqual(len(ready), 1, service.messages)
             watchdog = service.times("WATCHDOG=1")
-            # Half the watchdog's 400 ms: about 13 pings in the 2.6 s after readiness.
-            self.assertGreaterEqual(len(watchdog), 8, service.messages)
+            # Every half of the watchdog's second while frames complete: about 6 in the 3 s
+            # after readiness. Never a second without one, which would have systemd kill a
+            # graph whose frames flow (a ping waits for a completed frame: under ASan on a
+            # loaded machine, frames at 20/s have stalled 400 ms).
+            self.assertGreaterEqual(len(watchdog), 4, service.messages)
             self.assertTrue(all(t > ready[0] for t in watchdog))
-            self.assertLess(max(b - a for a, b in zip(watchdog, watchdog[1:])), 0.4)
+            self.assertLess(max(b - a for a, b in zip(watchdog, watchdog[1:])), 1.0)
             self.assertTrue(any(line.startswith("STATUS=frames ") for _, line in service.lines()),
                             service.messages)
             stopping = service.times("STOPPING=1")
