@@ -20,6 +20,7 @@ from ports import free_port, wait_for_port  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 NAMESPACE = "tilth-doctor-test"
+NETNS_DIR = "/run/netns"
 HOST_SIDE, CAMERA_SIDE = "tdoctor0", "tdoctor1"
 HOST_ADDRESS = "10.77.0.1"
 CAMERAS = ["10.77.0.11", "10.77.0.12"]
@@ -33,7 +34,7 @@ def sh(*args, check=True):
 def in_namespace(*args, check=True):
     # nsenter enters only the network namespace: `ip netns exec` also remounts /sys, which
     # a chroot (a clean root's test run) refuses.
-    return sh("nsenter", "--net=/run/netns/" + NAMESPACE, *args, check=check)
+    return sh("nsenter", "--net=" + os.path.join(NETNS_DIR, NAMESPACE), *args, check=check)
 
 
 def set_mtu(mtu):
@@ -44,6 +45,7 @@ def set_mtu(mtu):
 class Doctor(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
+        cls.netns_was_mounted = os.path.ismount(NETNS_DIR)
         sh("ip", "netns", "del", NAMESPACE, check=False)  # left by a killed run
         sh("ip", "link", "del", HOST_SIDE, check=False)
         sh("ip", "netns", "add", NAMESPACE)
@@ -56,7 +58,7 @@ class Doctor(unittest.TestCase):
         in_namespace("ip", "link", "set", CAMERA_SIDE, "up")
         in_namespace("ip", "link", "set", "lo", "up")
         cls.cameras = [subprocess.Popen(
-            ["nsenter", "--net=/run/netns/" + NAMESPACE, "arv-fake-gv-camera-0.8", "-i", address,
+            ["nsenter", "--net=" + os.path.join(NETNS_DIR, NAMESPACE), "arv-fake-gv-camera-0.8", "-i", address,
              "-s", "DOCTOR%d" % i], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             for i, address in enumerate(CAMERAS)]
         cls.plc_port = free_port()
@@ -79,6 +81,10 @@ class Doctor(unittest.TestCase):
             process.wait()
         sh("ip", "netns", "del", NAMESPACE, check=False)
         sh("ip", "link", "del", HOST_SIDE, check=False)
+        # `ip netns add` bind-mounts /run/netns onto itself; leave the machine as found, or a
+        # chroot this ran in cannot be removed.
+        if not cls.netns_was_mounted and not os.listdir(NETNS_DIR):
+            sh("umount", NETNS_DIR, check=False)
 
     def doctor(self, *args):
         done = subprocess.run([TILTH, "doctor", "--seconds", "2", *args, "--json"],
