@@ -19,6 +19,8 @@ packages=(
   libzstd-dev liblz4-dev zlib1g-dev nodejs
   # running as a systemd service; the packages (cpack) and their test in a bare root
   libsystemd-dev systemd dpkg-dev file debootstrap
+  # the live view's web server
+  libcpp-httplib-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # the fuzz targets: clang with libFuzzer and its sanitizer runtimes
@@ -27,6 +29,8 @@ packages=(
   python3-opencv python3-numpy
   # tilth ab tests: statistics recomputed independently, the report opened in a browser
   python3-scipy chromium
+  # the live view's test drives Chromium over its DevTools protocol
+  python3-websocket
 )
 
 missing=()

@@ -47,7 +47,7 @@ class InstalledTree(unittest.TestCase):
         self.assertEqual(plugins, sorted(
             f"tilth_{family}.so" for family in
             ["aravis", "depth", "estimation", "mcap", "modbus", "pairing", "recording",
-             "registration", "segmentation", "sinks", "synthetic"]))
+             "registration", "segmentation", "sinks", "synthetic", "view"]))
         self.assertEqual(sorted(os.listdir(self.installed("share", "tilth", "graphs"))),
                          sorted(os.listdir(os.path.join(SOURCE, "graphs"))))
         self.assertEqual(sorted(os.listdir(self.installed("share", "tilth", "calib"))),
