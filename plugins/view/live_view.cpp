@@ -5,6 +5,7 @@
 // waits on the renderer or on a viewer, so the measurement never slows for it.
 #include <pthread.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -82,7 +83,8 @@ class LiveView final : public Sink {
       cameras_ = frame.share_input<CameraStatus>(kCameras);
     }
     if (!server_->watched() || now < next_render_) return;
-    next_render_ = now + period_;
+    // On the period's grid, so that frames a little early or late do not lower the rate.
+    next_render_ = std::max(next_render_ + period_, now - period_ / 2);
     FrameMessages messages{frame.info().frame_id,
                            share<ColorImage>(frame, kColor),
                            share<RegisteredColor>(frame, kRegistered),
@@ -143,7 +145,8 @@ class LiveView final : public Sink {
     try {
       const std::optional<cv::Rect> roi =
           grid.width > 4 ? std::optional<cv::Rect>(roi_.on(grid)) : std::nullopt;
-      image_.publish(frame.frame_id, encode_jpeg(render_mosaic(frame, panel, roi), quality_));
+      render_mosaic(frame, panel, roi, mosaic_);
+      image_.publish(frame.frame_id, encode_jpeg(mosaic_, quality_));
       rendered_.fetch_add(1);
     } catch (const std::exception& failure) {
       if (render_failures_.fetch_add(1) == 0) {
@@ -198,6 +201,7 @@ class LiveView final : public Sink {
   std::chrono::steady_clock::time_point next_render_{};
   MeasurementHistory history_;
   LatestImage image_;
+  cv::Mat mosaic_;  // the renderer's
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -230,11 +234,11 @@ StageDescriptor describe() {
       ParamSpec::string("listen", "")
           .describe("HOST:PORT to serve on (\"0.0.0.0:8080\": every network; port 0: any free "
                     "port); empty: no server, nothing done"),
-      ParamSpec::number("fps", 10.0)
+      ParamSpec::number("fps", 8.0)
           .range(0.5, 30.0)
           .in_unit("1/s")
           .describe("images drawn per second while someone watches"),
-      ParamSpec::integer("width", 960)
+      ParamSpec::integer("width", 800)
           .range(320, 2560)
           .in_unit("px")
           .describe("width of the image sent (two panels side by side, two rows)"),

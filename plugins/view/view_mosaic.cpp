@@ -32,10 +32,16 @@ void caption(cv::Mat& panel, const std::string& text, int line, const cv::Scalar
   cv::putText(panel, text, origin, cv::FONT_HERSHEY_SIMPLEX, scale, color, 1, cv::LINE_AA);
 }
 
-cv::Mat empty_panel(cv::Size panel, const std::string& title) {
-  cv::Mat image(panel, CV_8UC3, cv::Scalar::all(40));
-  caption(image, title + ": not connected", 0, cv::Scalar::all(200));
-  return image;
+// Each draw_* fills `panel`, a view into the mosaic, in place, from the frame's images
+// resized to the panel once.
+struct PanelImages {
+  cv::Mat registered;  // BGR, grey where there is none
+  cv::Mat depth;       // mm, NaN where none; empty without depth
+};
+
+void draw_empty(cv::Mat panel, const std::string& title) {
+  panel.setTo(cv::Scalar::all(40));
+  caption(panel, title + ": not connected", 0, cv::Scalar::all(200));
 }
 
 cv::Mat shrink(const cv::Mat& image, cv::Size panel, int interpolation) {
@@ -44,10 +50,15 @@ cv::Mat shrink(const cv::Mat& image, cv::Size panel, int interpolation) {
   return out;
 }
 
-// The registered colour at panel size, or grey where there is none.
-cv::Mat registered_base(const FrameMessages& frame, cv::Size panel) {
-  if (frame.registered == nullptr) return cv::Mat(panel, CV_8UC3, cv::Scalar::all(60));
-  return shrink(frame.registered->bgr, panel, cv::INTER_LINEAR);
+PanelImages panel_images(const FrameMessages& frame, cv::Size panel) {
+  PanelImages images;
+  if (frame.registered == nullptr) {
+    images.registered = cv::Mat(panel, CV_8UC3, cv::Scalar::all(60));
+  } else {
+    images.registered = shrink(frame.registered->bgr, panel, cv::INTER_LINEAR);
+  }
+  if (frame.depth != nullptr) images.depth = shrink(frame.depth->mm, panel, cv::INTER_NEAREST);
+  return images;
 }
 
 cv::Size depth_grid(const FrameMessages& frame) {
@@ -58,24 +69,22 @@ cv::Size depth_grid(const FrameMessages& frame) {
 }
 
 // The colour camera's image fitted inside the panel, its aspect ratio kept.
-cv::Mat color_panel(const FrameMessages& frame, cv::Size panel) {
-  if (frame.color == nullptr) return empty_panel(panel, "colour camera");
+void draw_color(const FrameMessages& frame, cv::Mat panel) {
+  if (frame.color == nullptr) return draw_empty(panel, "colour camera");
   cv::Mat bgr;
   color::to_bgr(frame.color->pixels, frame.color->format, bgr);
-  const double scale = std::min(static_cast<double>(panel.width) / bgr.cols,
-                                static_cast<double>(panel.height) / bgr.rows);
+  const double scale = std::min(static_cast<double>(panel.cols) / bgr.cols,
+                                static_cast<double>(panel.rows) / bgr.rows);
   const cv::Size fitted(std::max(1, cvRound(bgr.cols * scale)),
                         std::max(1, cvRound(bgr.rows * scale)));
-  cv::Mat image(panel, CV_8UC3, cv::Scalar::all(0));
-  cv::resize(bgr,
-             image(cv::Rect((panel.width - fitted.width) / 2, (panel.height - fitted.height) / 2,
-                            fitted.width, fitted.height)),
-             fitted, 0, 0, cv::INTER_LINEAR);
-  caption(image,
+  panel.setTo(cv::Scalar::all(0));
+  cv::Mat inside = panel(cv::Rect((panel.cols - fitted.width) / 2, (panel.rows - fitted.height) / 2,
+                                  fitted.width, fitted.height));
+  cv::resize(bgr, inside, fitted, 0, 0, cv::INTER_LINEAR);
+  caption(panel,
           "colour camera " + std::to_string(frame.color->pixels.cols) + "x" +
               std::to_string(frame.color->pixels.rows),
           0, cv::Scalar::all(255));
-  return image;
 }
 
 std::string distance_text(const GroundDistance& distance) {
@@ -90,38 +99,38 @@ std::string distance_text(const GroundDistance& distance) {
   return text;
 }
 
-cv::Mat mask_panel(const FrameMessages& frame, cv::Size panel, std::optional<cv::Rect> roi) {
-  cv::Mat image = registered_base(frame, panel);
+void draw_mask(const FrameMessages& frame, const PanelImages& images, std::optional<cv::Rect> roi,
+               cv::Mat panel) {
+  images.registered.copyTo(panel);
   if (frame.mask != nullptr) {
-    const cv::Mat mask = shrink(frame.mask->values, panel, cv::INTER_NEAREST);
+    const cv::Mat mask = shrink(frame.mask->values, panel.size(), cv::INTER_NEAREST);
     cv::Mat tinted;
-    cv::addWeighted(image, 0.45, cv::Mat(panel, CV_8UC3, kResidueColor), 0.55, 0.0, tinted);
-    tinted.copyTo(image, mask == ResidueMask::kResidue);
-    cv::Mat dimmed = image * 0.5;
-    dimmed.copyTo(image, mask == ResidueMask::kUnknown);
+    cv::addWeighted(panel, 0.45, cv::Mat(panel.size(), CV_8UC3, kResidueColor), 0.55, 0.0, tinted);
+    tinted.copyTo(panel, mask == ResidueMask::kResidue);
+    cv::Mat dimmed = panel * 0.5;
+    dimmed.copyTo(panel, mask == ResidueMask::kUnknown);
   }
   const cv::Size grid = depth_grid(frame);
   if (roi && !grid.empty()) {
-    const double sx = static_cast<double>(panel.width) / grid.width;
-    const double sy = static_cast<double>(panel.height) / grid.height;
-    cv::rectangle(image,
+    const double sx = static_cast<double>(panel.cols) / grid.width;
+    const double sy = static_cast<double>(panel.rows) / grid.height;
+    cv::rectangle(panel,
                   cv::Rect(cvRound(roi->x * sx), cvRound(roi->y * sy), cvRound(roi->width * sx),
                            cvRound(roi->height * sy)),
                   kRoiColor, 2);
   }
-  caption(image,
+  caption(panel,
           frame.mask != nullptr ? "residue (red), region (yellow)" : "residue: not connected", 0,
           cv::Scalar::all(255));
   if (frame.distance != nullptr) {
-    caption(image, distance_text(*frame.distance), 1,
+    caption(panel, distance_text(*frame.distance), 1,
             frame.distance->valid ? kValidColor : kInvalidColor);
   }
-  return image;
 }
 
-cv::Mat depth_panel(const FrameMessages& frame, cv::Size panel) {
-  if (frame.depth == nullptr) return empty_panel(panel, "depth");
-  const cv::Mat depth = shrink(frame.depth->mm, panel, cv::INTER_NEAREST);
+void draw_depth(const PanelImages& images, cv::Mat panel) {
+  if (images.depth.empty()) return draw_empty(panel, "depth");
+  const cv::Mat& depth = images.depth;
   const cv::Mat measured = depth == depth;  // NaN compares unequal
   double lo = 0.0;
   double hi = 0.0;
@@ -129,24 +138,21 @@ cv::Mat depth_panel(const FrameMessages& frame, cv::Size panel) {
   if (hi <= lo) hi = lo + 1.0;
   cv::Mat scaled;
   depth.convertTo(scaled, CV_8U, 255.0 / (hi - lo), -lo * 255.0 / (hi - lo));
-  cv::Mat image;
-  cv::applyColorMap(scaled, image, cv::COLORMAP_TURBO);
-  image.setTo(cv::Scalar::all(0), ~measured);
+  cv::applyColorMap(scaled, panel, cv::COLORMAP_TURBO);
+  panel.setTo(cv::Scalar::all(0), ~measured);
   char text[64];
   std::snprintf(text, sizeof text, "depth %.0f (blue) - %.0f mm (red)", lo, hi);
-  caption(image, text, 0, cv::Scalar::all(255));
-  return image;
+  caption(panel, text, 0, cv::Scalar::all(255));
 }
 
-cv::Mat edges_panel(const FrameMessages& frame, cv::Size panel) {
+void draw_edges(const PanelImages& images, cv::Mat panel) {
   cv::Mat gray;
-  cv::cvtColor(registered_base(frame, panel), gray, cv::COLOR_BGR2GRAY);
-  cv::Mat image;
-  cv::cvtColor(gray, image, cv::COLOR_GRAY2BGR);
-  if (frame.depth != nullptr) {
+  cv::cvtColor(images.registered, gray, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(gray, panel, cv::COLOR_GRAY2BGR);
+  if (!images.depth.empty()) {
     // A one-pixel line where the depth steps to the next pixel right or down (NaN, no
     // depth, makes no step).
-    const cv::Mat depth = shrink(frame.depth->mm, panel, cv::INTER_NEAREST);
+    const cv::Mat& depth = images.depth;
     const int cols = depth.cols;
     const int rows = depth.rows;
     cv::Mat edges = cv::Mat::zeros(depth.size(), CV_8UC1);
@@ -156,22 +162,24 @@ cv::Mat edges_panel(const FrameMessages& frame, cv::Size panel) {
     step = cv::abs(depth.rowRange(1, rows) - depth.rowRange(0, rows - 1)) > kEdgeStepMm;
     cv::Mat down = edges.rowRange(1, rows);
     down |= step;
-    image.setTo(kEdgeColor, edges);
+    panel.setTo(kEdgeColor, edges);
   }
-  caption(image, "registration: depth edges (magenta) on colour", 0, cv::Scalar::all(255));
-  return image;
+  caption(panel, "registration: depth edges (magenta) on colour", 0, cv::Scalar::all(255));
 }
 
 }  // namespace
 
-cv::Mat render_mosaic(const FrameMessages& frame, cv::Size panel, std::optional<cv::Rect> roi) {
-  cv::Mat top;
-  cv::Mat bottom;
-  cv::hconcat(color_panel(frame, panel), mask_panel(frame, panel, roi), top);
-  cv::hconcat(depth_panel(frame, panel), edges_panel(frame, panel), bottom);
-  cv::Mat mosaic;
-  cv::vconcat(top, bottom, mosaic);
-  return mosaic;
+void render_mosaic(const FrameMessages& frame, cv::Size panel, std::optional<cv::Rect> roi,
+                   cv::Mat& mosaic) {
+  mosaic.create(panel.height * 2, panel.width * 2, CV_8UC3);
+  const auto at = [&](int column, int row) {
+    return mosaic(cv::Rect(column * panel.width, row * panel.height, panel.width, panel.height));
+  };
+  const PanelImages images = panel_images(frame, panel);
+  draw_color(frame, at(0, 0));
+  draw_mask(frame, images, roi, at(1, 0));
+  draw_depth(images, at(0, 1));
+  draw_edges(images, at(1, 1));
 }
 
 std::vector<unsigned char> encode_jpeg(const cv::Mat& image, int quality) {

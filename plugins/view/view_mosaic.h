@@ -30,7 +30,9 @@ struct FrameMessages {
 // and the region of interest (yellow) on the registered colour; the depth as a colour
 // map; the depth's edges (magenta) on the registered colour, where a misaligned rig shows
 // as edges beside the colour's. `panel` is one panel's size; `roi` is in depth pixels.
-cv::Mat render_mosaic(const FrameMessages& frame, cv::Size panel, std::optional<cv::Rect> roi);
+// `mosaic` is drawn in place when it has the size already, as a renderer's reused image.
+void render_mosaic(const FrameMessages& frame, cv::Size panel, std::optional<cv::Rect> roi,
+                   cv::Mat& mosaic);
 
 // JPEG bytes of `image` at `quality` (1-100).
 std::vector<unsigned char> encode_jpeg(const cv::Mat& image, int quality);

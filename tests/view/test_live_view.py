@@ -26,7 +26,7 @@ from ports import free_port  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 GRAPH = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs", "simulated", "seeder.json")
-VIEW_WIDTH = 960  # view.live's default width: two panels of the 640x480 depth grid
+VIEW_WIDTH = 800  # view.live's default width: two panels of 400x300 for the 640x480 depth grid
 MAX_LOG_BYTES = 1_000_000
 
 
@@ -124,7 +124,7 @@ class LiveView(unittest.TestCase):
             time.sleep(3.0)
             second = browser.evaluate("({images: tilthView.images, frame: tilthView.frameId,"
                                       " samples: tilthView.samples, plotted: tilthView.plotted})")
-            # at 10 frames/s in and 10 images/s out, 3 s bring more than a few of each
+            # at 10 frames/s in and 8 images/s out, 3 s bring more than a few of each
             self.assertGreaterEqual(second["images"] - first["images"], 3)
             self.assertGreater(second["frame"], first["frame"])
             self.assertGreaterEqual(second["samples"] - first["samples"], 3)
