@@ -11,7 +11,8 @@ showing every input the machine graphs give it. For `--seconds` without a viewer
 for as long with one (a client that does what the page does: it holds the event stream
 open and pulls each next image as soon as it has the last), it samples the utime+stime of
 the process's threads named view-* (/proc/PID/task/*/stat) and the view stage's mean time
-per frame (status.json). It prints each as a percentage of one core. Every process it
+per frame (status.json). It prints each as a percentage of one core, with the camera
+frames lost, late or incomplete and the graph's drops in each phase. Every process it
 starts is stopped by its pid; tilth's log is bounded."""
 import argparse
 import json
@@ -58,9 +59,13 @@ class Viewer(threading.Thread):
 
     def run(self):
         events = urllib.request.urlopen(self.url + "events", timeout=10)
-        drain = threading.Thread(target=lambda: [None for _ in iter(lambda: events.read1(65536), b"")],
-                                 daemon=True)
-        drain.start()
+        def drain():
+            try:
+                while events.read1(65536):
+                    pass
+            except (OSError, ValueError, AttributeError):
+                pass  # closed at the end
+        threading.Thread(target=drain, daemon=True).start()
         generation = 0
         while not self.stopping.is_set():
             with urllib.request.urlopen(self.url + "frame.jpg?after=%d" % generation,
@@ -83,11 +88,15 @@ def measure(tilth, url, seconds):
     cpu1, wall1 = view_thread_seconds(tilth.pid), time.monotonic()
     status1, stage = view_stage()
     frames = status1["frames_completed"] - status0["frames_completed"]
+    cameras = ("lost", "late", "incomplete")
+    missed = sum(status1["cameras"][k] - status0["cameras"][k] for k in cameras)
     wall = wall1 - wall0
     return {"frames_per_second": frames / wall,
             "view_threads_percent": 100.0 * (cpu1 - cpu0) / wall,
             "view_stage_percent": 100.0 * stage["mean_ms"] * 1e-3 * frames / wall,
-            "images": status1["images_rendered"] - status0["images_rendered"]}
+            "images": status1["images_rendered"] - status0["images_rendered"],
+            "camera_frames_missed": missed,
+            "graph_frames_dropped": status1["frames_dropped"] - status0["frames_dropped"]}
 
 
 def main():
@@ -149,9 +158,10 @@ def main():
         viewer.join(15)
         for name, figures in (("nobody watching", idle), ("one viewer", watched)):
             print("%-16s %5.1f frames/s  view threads %5.2f %% of a core  view stage %5.3f %%  "
-                  "images drawn %d" % (name, figures["frames_per_second"],
-                                       figures["view_threads_percent"],
-                                       figures["view_stage_percent"], figures["images"]))
+                  "images drawn %d  camera frames lost/late/incomplete %d  graph drops %d" % (
+                      name, figures["frames_per_second"], figures["view_threads_percent"],
+                      figures["view_stage_percent"], figures["images"],
+                      figures["camera_frames_missed"], figures["graph_frames_dropped"]))
         if viewer.images:
             print("image size %.0f kB mean (%d images pulled)" %
                   (viewer.bytes / viewer.images / 1000, viewer.images))

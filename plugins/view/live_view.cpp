@@ -1,8 +1,9 @@
 // view.live: a web page to watch while mounting and aiming the cameras (docs/live-view.md).
 // The graph hands it each frame's messages; it keeps the measurement for the plot and,
-// only while someone watches and at most `fps` times a second, passes the messages to
-// its renderer thread, replacing any the renderer has not taken yet. Nothing it does
-// waits on the renderer or on a viewer, so the measurement never slows for it.
+// only while someone watches, at most `fps` times a second and when its renderer thread
+// is idle, passes the messages to that thread. It holds one frame's images at most, for
+// as long as drawing them takes (a colour image may be a camera's stream buffer). Nothing
+// it does waits on the renderer or on a viewer, so the measurement never slows for it.
 #include <pthread.h>
 
 #include <algorithm>
@@ -82,7 +83,7 @@ class LiveView final : public Sink {
       std::lock_guard lock(mutex_);
       cameras_ = frame.share_input<CameraStatus>(kCameras);
     }
-    if (!server_->watched() || now < next_render_) return;
+    if (!server_->watched() || now < next_render_ || drawing_.load()) return;
     // On the period's grid, so that frames a little early or late do not lower the rate.
     next_render_ = std::max(next_render_ + period_, now - period_ / 2);
     FrameMessages messages{frame.info().frame_id,
@@ -91,9 +92,9 @@ class LiveView final : public Sink {
                            share<ResidueMask>(frame, kMask),
                            share<DepthImage>(frame, kDepth),
                            share<GroundDistance>(frame, kDistance)};
+    drawing_.store(true);
     {
       std::lock_guard lock(mutex_);
-      if (pending_) ++superseded_;
       pending_ = std::move(messages);
     }
     wake_.notify_one();
@@ -123,10 +124,13 @@ class LiveView final : public Sink {
     for (;;) {
       wake_.wait(lock, [this] { return done_ || pending_.has_value(); });
       if (done_) return;
-      const FrameMessages frame = std::move(*pending_);
-      pending_.reset();
-      lock.unlock();
-      render(frame);
+      {
+        const FrameMessages frame = std::move(*pending_);
+        pending_.reset();
+        lock.unlock();
+        render(frame);
+      }  // the frame's images released
+      drawing_.store(false);
       lock.lock();
     }
   }
@@ -178,7 +182,6 @@ class LiveView final : public Sink {
                              {"images_rendered", rendered_.load()},
                              {"cameras", nullptr}};
     std::lock_guard lock(mutex_);
-    status["images_superseded"] = superseded_;
     if (cameras_) {
       status["cameras"] = {{"camera", cameras_->camera},
                            {"streaming", cameras_->streaming},
@@ -207,8 +210,8 @@ class LiveView final : public Sink {
   std::condition_variable wake_;
   std::optional<FrameMessages> pending_;
   std::shared_ptr<const CameraStatus> cameras_;
-  std::uint64_t superseded_ = 0;
   bool done_ = false;
+  std::atomic<bool> drawing_{false};  // from handing a frame over until its images are released
   std::atomic<std::uint64_t> rendered_{0};
   std::atomic<std::uint64_t> render_failures_{0};
 
