@@ -17,6 +17,7 @@ starts is stopped by its pid; tilth's log is bounded."""
 import argparse
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -176,6 +177,7 @@ def main():
                 tilth.wait()
         depth.kill()
         color.kill()
+        shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":

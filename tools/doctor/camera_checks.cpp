@@ -167,6 +167,10 @@ Finding packet_finding(const Camera& camera, const std::vector<NetworkInterface>
   return finding;
 }
 
+// Frames not assembled in time although no packet was missing, in percent of the frames
+// streamed: up to this a warning (a busy moment), above it a failure.
+constexpr std::uint64_t kBusyHostFailPercent = 5;
+
 Finding stream_finding(const Camera& camera) {
   Finding finding{"camera " + camera.address + ": streaming"};
   const StreamStats& stats = camera.stats;
@@ -181,11 +185,19 @@ Finding stream_finding(const Camera& camera) {
                    std::to_string(stats.incomplete) + " incomplete, " +
                    std::to_string(stats.missing_packets) + " packets missing, " +
                    std::to_string(stats.resent_packets) + " resent";
-  if (stats.frames == 0 || stats.incomplete > 0 || stats.missing_packets > 0) {
+  if (stats.frames == 0 || stats.missing_packets > 0) {
     finding.verdict = Verdict::kFailed;
     finding.fix =
         "lost packets: raise net.core.rmem_max, enable jumbo frames, give the "
         "cameras a NIC of their own, check cables and switch";
+  } else if (stats.incomplete > 0) {
+    // Every packet came, yet a frame was not assembled in time: the host, not the network.
+    finding.verdict = stats.incomplete * 100 > stats.frames * kBusyHostFailPercent
+                          ? Verdict::kFailed
+                          : Verdict::kWarning;
+    finding.fix =
+        "frames timed out with no packet missing: this host was too busy to take them in; "
+        "lower its load, or raise the camera stage's receive priority (receive_nice)";
   } else if (stats.resent_packets > 0) {
     finding.verdict = Verdict::kWarning;
     finding.fix = "packets were resent: the link or the receiving host is near its limit";
