@@ -178,7 +178,6 @@ class LiveView final : public Sink {
                              {"frames_per_second", metrics.frames_per_second},
                              {"end_to_end_p99_ms", metrics.end_to_end.p99_ms},
                              {"stages", std::move(stages)},
-                             {"viewers", server_ ? server_->viewers() : 0},
                              {"images_rendered", rendered_.load()},
                              {"cameras", nullptr}};
     std::lock_guard lock(mutex_);

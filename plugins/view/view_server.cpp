@@ -81,6 +81,12 @@ bool ViewServer::watched() const {
 
 void ViewServer::touch() { last_request_ns_.store(steady_ns()); }
 
+nlohmann::json ViewServer::status() const {
+  nlohmann::json status = content_.status();
+  status["viewers"] = viewers();
+  return status;
+}
+
 bool ViewServer::wait_stopping(std::chrono::milliseconds timeout) {
   std::unique_lock lock(stop_mutex_);
   return stop_.wait_for(lock, timeout, [this] { return stopping_; });
@@ -98,7 +104,7 @@ void ViewServer::route() {
 
   server_->Get("/status.json", [this](const httplib::Request&, httplib::Response& response) {
     response.set_header("Cache-Control", "no-store");
-    response.set_content(content_.status().dump(), "application/json");
+    response.set_content(status().dump(), "application/json");
   });
 
   // The next image after the one the viewer has: it pulls at its own pace, so a viewer on
@@ -157,7 +163,7 @@ void ViewServer::route() {
           std::string out;
           if (!stream->opened) {
             stream->opened = true;
-            out = "retry: 1000\n\n" + event("status", content_.status());
+            out = "retry: 1000\n\n" + event("status", status());
           } else if (wait_stopping(kEventPeriod)) {
             return false;
           }
@@ -166,7 +172,7 @@ void ViewServer::route() {
             stream->sent = samples["last"].get<std::uint64_t>();
             out += event("samples", samples);
           }
-          if (++stream->ticks % kStatusEveryEvents == 0) out += event("status", content_.status());
+          if (++stream->ticks % kStatusEveryEvents == 0) out += event("status", status());
           if (out.empty()) out = ": keep-alive\n\n";
           return sink.write(out.data(), out.size());
         },

@@ -25,7 +25,8 @@ namespace tilth::view {
 
 class ViewServer {
  public:
-  // What it serves: the stage's latest image and history, and its status on demand.
+  // What it serves: the stage's latest image and history, and its status on demand
+  // (called on the server's threads).
   struct Content {
     LatestImage* image;
     const MeasurementHistory* history;
@@ -47,6 +48,8 @@ class ViewServer {
  private:
   void route();
   void touch();
+  // The stage's status with the number of viewers.
+  nlohmann::json status() const;
   bool wait_stopping(std::chrono::milliseconds timeout);
 
   Content content_;
