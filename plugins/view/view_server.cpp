@@ -59,7 +59,17 @@ ViewServer::ViewServer(const std::string& host, int port, Content content)
   thread_ = std::thread([this] {
     pthread_setname_np(pthread_self(), "view-listen");
     server_->listen_after_bind();
+    listener_returned_.store(true);
   });
+  // stop() ends only a server already listening: a run that ends at once must not leave
+  // the listener to start after it.
+  while (!server_->is_running() && !listener_returned_.load()) {
+    std::this_thread::sleep_for(1ms);
+  }
+  if (!server_->is_running()) {
+    thread_.join();
+    throw Error("the live view cannot listen on " + host + ":" + std::to_string(port_));
+  }
 }
 
 ViewServer::~ViewServer() {

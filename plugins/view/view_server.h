@@ -57,6 +57,7 @@ class ViewServer {
   int port_ = 0;
   std::atomic<std::int64_t> last_request_ns_{0};
   std::atomic<int> viewers_{0};
+  std::atomic<bool> listener_returned_{false};
   std::mutex stop_mutex_;
   std::condition_variable stop_;
   bool stopping_ = false;

@@ -26,6 +26,7 @@ from ports import free_port  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 GRAPH = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs", "simulated", "seeder.json")
+DEMO = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs", "demo.json")
 VIEW_WIDTH = 800  # view.live's default width: two panels of 400x300 for the 640x480 depth grid
 MAX_LOG_BYTES = 1_000_000
 
@@ -219,6 +220,16 @@ class LiveView(unittest.TestCase):
             self.assertLess(time.monotonic() - started, 15)
         finally:
             events.close()
+
+
+class ShortRun(unittest.TestCase):
+    def test_a_run_of_one_frame_ends_with_its_server(self):
+        # The server stops even when the run ends before it has served anything.
+        for _ in range(3):
+            done = subprocess.run([TILTH, "run", DEMO, "--var", "view=127.0.0.1:0", "--frames", "1"],
+                                  capture_output=True, text=True, timeout=120)
+            self.assertEqual(done.returncode, 0, done.stderr[-2000:])
+            self.assertIn("live view at http://127.0.0.1:", done.stderr)
 
 
 class Refused(unittest.TestCase):
