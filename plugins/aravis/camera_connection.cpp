@@ -60,6 +60,10 @@ CameraConnection::CameraConnection(const CameraSettings& settings, const Logger&
     arv_camera_start_acquisition(camera_.get(), error.out());
     error.check("starting acquisition on camera " + label);
     acquiring_ = true;
+    if (settings.software_trigger_hz > 0.0) {
+      trigger_ = std::make_unique<SoftwareTrigger>(camera_.get(), settings.software_trigger_hz,
+                                                   label, settings.receive_nice, log);
+    }
   } catch (...) {
     close();
     throw;
@@ -78,6 +82,7 @@ void CameraConnection::close() {
     g_signal_handler_disconnect(arv_camera_get_device(camera_.get()), control_lost_handler_);
     control_lost_handler_ = 0;
   }
+  trigger_.reset();
   if (acquiring_) {
     arv_camera_stop_acquisition(camera_.get(), nullptr);  // fails when the camera is gone
     acquiring_ = false;

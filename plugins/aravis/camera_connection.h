@@ -15,6 +15,7 @@
 #include "aravis/gobject_ptr.h"
 #include "camera_settings.h"
 #include "camera_setup.h"
+#include "software_trigger.h"
 #include "stream_buffers.h"
 #include "tilth/log.h"
 
@@ -62,6 +63,7 @@ class CameraConnection {
   std::shared_ptr<StreamBuffers> buffers_;
   gulong control_lost_handler_ = 0;
   bool acquiring_ = false;
+  std::unique_ptr<SoftwareTrigger> trigger_;  // while acquiring, with trigger_mode host_clock
 };
 
 }  // namespace tilth::aravis

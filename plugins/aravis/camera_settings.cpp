@@ -1,9 +1,12 @@
 #include "camera_settings.h"
 
+#include "tilth/error.h"
+
 namespace tilth::aravis {
 namespace {
 
 constexpr const char* kCurrent = "current";
+constexpr const char* kHostClock = "host_clock";
 
 }  // namespace
 
@@ -28,10 +31,13 @@ std::vector<ParamSpec> camera_param_specs(const std::vector<ImageFormat>& format
       ParamSpec::number("frame_rate", 0.0)
           .range(0.0, std::nullopt)
           .in_unit("Hz")
-          .describe("acquisition frame rate (AcquisitionFrameRate); 0 = the camera's"),
-      ParamSpec::choice("trigger_mode", {kCurrent, "off", "on"}, kCurrent)
+          .describe("acquisition frame rate (AcquisitionFrameRate); 0 = the camera's; with "
+                    "trigger_mode host_clock, the rate of the triggers instead"),
+      ParamSpec::choice("trigger_mode", {kCurrent, "off", "on", kHostClock}, kCurrent)
           .describe("frame start trigger (TriggerSelector FrameStart, TriggerMode): off = "
-                    "free running, on = one frame per trigger"),
+                    "free running, on = one frame per trigger, host_clock = a software "
+                    "trigger at frame_rate on a grid of the host's clock that every camera at "
+                    "that rate shares, so that they expose together"),
       ParamSpec::string("trigger_source", "")
           .describe("TriggerSource when triggered (Line1, Software, ...); empty = the "
                     "camera's"),
@@ -83,8 +89,20 @@ CameraSettings read_camera_settings(const Params& params, const std::vector<Imag
   settings.gain = params.number("gain");
   settings.frame_rate_hz = params.number("frame_rate");
   const std::string trigger = params.string("trigger_mode");
-  if (trigger != kCurrent) settings.trigger_mode = trigger == "on" ? "On" : "Off";
+  if (trigger != kCurrent) settings.trigger_mode = trigger == "off" ? "Off" : "On";
   settings.trigger_source = params.string("trigger_source");
+  if (trigger == kHostClock) {
+    if (settings.frame_rate_hz <= 0.0) {
+      throw Error("trigger_mode host_clock needs frame_rate: the rate of the triggers, in Hz");
+    }
+    if (!settings.trigger_source.empty() && settings.trigger_source != "Software") {
+      throw Error("trigger_mode host_clock fires TriggerSource Software; trigger_source is '" +
+                  settings.trigger_source + "'");
+    }
+    settings.trigger_source = "Software";
+    settings.software_trigger_hz = settings.frame_rate_hz;
+    settings.frame_rate_hz = 0.0;  // the triggers set the rate, not AcquisitionFrameRate
+  }
   settings.packet_size = params.integer("packet_size");
   settings.packet_delay_ns = params.integer("packet_delay_ns");
   settings.packet_socket = params.boolean("packet_socket");

@@ -24,8 +24,9 @@ struct CameraSettings {
   double frame_rate_hz = 0.0;                         // 0 = the camera's
   std::string trigger_mode;                           // "Off", "On"; "" = the camera's
   std::string trigger_source;                         // "" = the camera's
-  std::int64_t packet_size = 0;                       // bytes; 0 = the camera's
-  std::int64_t packet_delay_ns = -1;                  // negative = the camera's
+  double software_trigger_hz = 0.0;   // > 0: fired on the host clock's grid (software_trigger.h)
+  std::int64_t packet_size = 0;       // bytes; 0 = the camera's
+  std::int64_t packet_delay_ns = -1;  // negative = the camera's
   bool packet_socket = true;
   bool packet_resend = true;
   int receive_nice = -10;  // Aravis's receiving thread; 0 = as the process

@@ -137,9 +137,22 @@ class Setup {
               number_text(*description.offset_mm) + " mm (Scan3dCoordinateScale / Offset)");
   }
 
-  void describe(CameraDescription& description) {
+  void require_software_trigger() {
     GErrorSlot error;
-    if (arv_camera_is_frame_rate_available(camera_, nullptr)) {
+    const bool supported = arv_camera_is_software_trigger_supported(camera_, error.out());
+    error.check("reading whether camera " + label_ + " takes a software trigger");
+    if (!supported) {
+      throw Error("camera " + label_ +
+                  " has no software trigger (TriggerSoftware), which trigger_mode host_clock "
+                  "fires");
+    }
+  }
+
+  void describe(double software_trigger_hz, CameraDescription& description) {
+    GErrorSlot error;
+    if (software_trigger_hz > 0.0) {
+      description.frame_rate_hz = software_trigger_hz;
+    } else if (arv_camera_is_frame_rate_available(camera_, nullptr)) {
       description.frame_rate_hz = arv_camera_get_frame_rate(camera_, error.out());
       error.check("reading the frame rate of camera " + label_);
     }
@@ -187,6 +200,7 @@ CameraDescription configure_camera(ArvCamera* camera, const std::string& label,
   }
   if (!settings.pixel_format.empty()) setup.set_feature("PixelFormat", settings.pixel_format);
   setup.set_trigger(settings.trigger_mode, settings.trigger_source);
+  if (settings.software_trigger_hz > 0.0) setup.require_software_trigger();
   if (settings.exposure_us > 0.0) {
     setup.set_standard("exposure time", "ExposureTime or ExposureTimeAbs", settings.exposure_us,
                        arv_camera_is_exposure_time_available, arv_camera_set_exposure_time,
@@ -206,7 +220,7 @@ CameraDescription configure_camera(ArvCamera* camera, const std::string& label,
   for (const auto& feature : settings.features) setup.set_feature(feature.name, feature.value);
   setup.check_format(*settings.formats, description);
   setup.read_scan3d(description);
-  setup.describe(description);
+  setup.describe(settings.software_trigger_hz, description);
   return description;
 }
 

@@ -18,7 +18,7 @@ namespace tilth::aravis {
 struct CameraDescription {
   std::string label;                          // "Aravis Fake (serial TESTA) at 127.0.0.1"
   std::string pixel_format;                   // as the camera names it
-  double frame_rate_hz = 0.0;                 // 0: the camera has no frame rate feature
+  double frame_rate_hz = 0.0;                 // or the software trigger's; 0: neither known
   std::optional<std::uint32_t> component_id;  // of the selected component
   std::optional<std::uint32_t> companion_id;  // of the component enabled beside it
   std::optional<double> scale_mm;             // Scan3dCoordinateScale, when the camera has it

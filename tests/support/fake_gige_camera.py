@@ -1,5 +1,8 @@
 """Aravis's GigE Vision camera simulator (arv-fake-gv-camera-0.8) on a loopback address
-of its own, started and killed by its pid."""
+of its own, started and killed by its pid. With trigger_checks_hz, the simulator is
+tilth-fake-gige-camera (its path in TILTH_FAKE_CAMERA), which looks for a software
+trigger that many times a second instead of arv-fake-gv-camera's 25."""
+import os
 import socket
 import struct
 import subprocess
@@ -15,8 +18,9 @@ def udp_bound(address, port):
 
 
 class FakeCamera:
-    def __init__(self, address, serial):
+    def __init__(self, address, serial, trigger_checks_hz=None):
         self.address, self.serial, self.process = address, serial, None
+        self.trigger_checks_hz = trigger_checks_hz
         shown = subprocess.run(["ip", "-o", "addr", "show", "dev", "lo"], capture_output=True,
                                text=True, check=True).stdout
         if " inet %s/" % address not in shown:
@@ -26,9 +30,13 @@ class FakeCamera:
         assert not udp_bound(self.address, GVCP_PORT), "a device already listens on " + self.address
         # At a higher priority than the tests: the simulator plays a camera, which has a
         # processor of its own.
-        self.process = subprocess.Popen(
-            ["nice", "-n", "-10", "arv-fake-gv-camera-0.8", "-i", self.address, "-s", self.serial],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if self.trigger_checks_hz:
+            simulator = [os.environ["TILTH_FAKE_CAMERA"], self.address, self.serial,
+                         str(self.trigger_checks_hz)]
+        else:
+            simulator = ["arv-fake-gv-camera-0.8", "-i", self.address, "-s", self.serial]
+        self.process = subprocess.Popen(["nice", "-n", "-10"] + simulator,
+                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         deadline = time.monotonic() + 5
         while not udp_bound(self.address, GVCP_PORT):
             assert time.monotonic() < deadline, "the simulator did not start on " + self.address
