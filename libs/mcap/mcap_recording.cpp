@@ -1,6 +1,10 @@
 #include "mcap/mcap_recording.h"
 
+#include <time.h>
+
 #include <algorithm>
+#include <ctime>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <optional>
@@ -21,6 +25,16 @@ std::string seconds_text(double seconds) {
 }
 
 }  // namespace
+
+std::string utc_time_text(std::uint64_t time_ns) {
+  const auto seconds = static_cast<std::time_t>(time_ns / 1'000'000'000);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  std::ostringstream text;
+  text << std::put_time(&utc, "%Y-%m-%dT%H:%M:%S") << '.' << std::setfill('0') << std::setw(3)
+       << time_ns / 1'000'000 % 1000 << 'Z';
+  return text.str();
+}
 
 RecordingInfo recording_info(const std::filesystem::path& file) {
   McapReader reader(file);
@@ -125,8 +139,12 @@ std::string format_info(const RecordingInfo& info) {
     if (info.compressions.size() > 1) compressions += " (" + std::to_string(chunks) + " chunks)";
   }
   text << "compression: " << (compressions.empty() ? "-" : compressions) << "\n";
-  text << "duration:    " << seconds_text(info.duration_s()) << " (log time " << info.start_time_ns
-       << " to " << info.end_time_ns << " ns)\n";
+  text << "duration:    " << seconds_text(info.duration_s());
+  if (info.message_count > 0) {
+    text << " (log time " << utc_time_text(info.start_time_ns) << " to "
+         << utc_time_text(info.end_time_ns) << ")";
+  }
+  text << "\n";
   text << "channels:\n";
   for (const ChannelInfo& channel : info.channels) {
     text << "  " << channel.topic << "  " << channel.message_count << " messages  "

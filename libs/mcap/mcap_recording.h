@@ -53,6 +53,9 @@ struct RecordingInfo {
 RecordingInfo recording_info(const std::filesystem::path& file);
 // Lines of text for a terminal.
 std::string format_info(const RecordingInfo& info);
+// A log time (nanoseconds since the Unix epoch) as UTC in ISO 8601 with milliseconds,
+// truncated: 2026-11-25T08:17:52.123Z.
+std::string utc_time_text(std::uint64_t time_ns);
 
 struct RepairResult {
   std::uint64_t chunks = 0;

@@ -166,6 +166,19 @@ class Run(unittest.TestCase):
         self.assertIn("10 frames completed, 0 dropped", result.stderr)
         self.assertRegex(result.stderr, r"camera\s+synthetic\.tof_plane\s+1[01]\s")
 
+    def test_quiet_prints_no_info_lines(self):
+        # Log lines are "LEVEL: WHERE: MESSAGE" (sdk/src/log.cpp). --quiet keeps warnings and
+        # errors only, and drops the status line and the summary; what the graph prints stays.
+        args = ["run", PLANE, "--frames", "3", "--set", "camera.fps=0", "--set", "print.every=1"]
+        loud = tilth(*args)
+        self.assertEqual(loud.returncode, 0, loud.stderr)
+        self.assertRegex(loud.stderr, r"(?m)^info: run: running ")
+        quiet = tilth(*args, "--quiet")
+        self.assertEqual(quiet.returncode, 0, quiet.stderr)
+        self.assertNotRegex(quiet.stderr, r"(?m)^info: ")
+        self.assertNotIn("frames completed", quiet.stderr)
+        self.assertEqual(quiet.stdout, loud.stdout)
+
     def stop_with(self, signum):
         process = subprocess.Popen(
             [TILTH, "run", PLANE, "--set", "camera.fps=100", "--set", "print.every=1",

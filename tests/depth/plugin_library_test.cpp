@@ -2,11 +2,11 @@
 // depth.projection, which projects a frame, and a bad calibration stops it with the node
 // and the field named.
 #include <filesystem>
-#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "calibration_file.h"
 #include "framework/stage_registry.h"
 #include "source_tree.h"
 #include "tilth/error.h"
@@ -49,22 +49,19 @@ TEST(DepthPlugin, TheLibraryProvidesTheProjectionStage) {
 }
 
 TEST(DepthPlugin, ABadCalibrationStopsTheNodeWithTheFieldNamed) {
-  std::ifstream in(kPaperRig);
-  nlohmann::json rig = nlohmann::json::parse(in);
+  nlohmann::json rig = testing::paper_rig_document();
   rig["depth_camera"]["fx"] = 0;
-  const fs::path file = fs::temp_directory_path() / "tilth_depth_plugin_bad.calib.json";
-  std::ofstream(file) << rig.dump();
+  const testing::CalibrationFile file(rig);
   StageRegistry registry;
   registry.load(TILTH_DEPTH_PLUGIN);
   try {
-    registry.create("depth.projection", context_for(file));
+    registry.create("depth.projection", context_for(file.path()));
     ADD_FAILURE() << "the stage started";
   } catch (const Error& error) {
     EXPECT_EQ(std::string(error.what()),
-              "node 'depth' (depth.projection) failed to start: " + file.string() +
+              "node 'depth' (depth.projection) failed to start: " + file.path().string() +
                   ":/depth_camera/fx: expected a number > 0, got 0");
   }
-  fs::remove(file);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include "calibration_file.h"
 #include "estimators.h"
 #include "source_tree.h"
 #include "synthetic_ground.h"
@@ -112,13 +113,11 @@ TEST(GroundPlane, SameFrameSamePlane) {
 TEST(GroundPlane, UndistortsThroughTheCalibration) {
   RigCalibration rig = load_calibration(kPaperRig);
   rig.depth.distortion = {-0.4, 0.15, 0.0, 0.0, 0.0};
-  const auto file = std::filesystem::temp_directory_path() / "tilth_distorted.calib.json";
-  save_calibration(rig, file);
+  const testing::CalibrationFile file(to_json(rig));
   GroundScene scene = tilted_scene_with_outliers();
   const cv::Mat depth = testing::render(scene, rig.depth);
 
-  TransformHarness stage(describe_ground_plane(), with_calibration(json::object(), file));
-  std::filesystem::remove(file);
+  TransformHarness stage(describe_ground_plane(), with_calibration(json::object(), file.path()));
   const GroundDistance out = stage.run({depth_message(depth)})[0].get<GroundDistance>();
   ASSERT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(*out.tilt_x_deg, 5.0, kTiltToleranceDeg);

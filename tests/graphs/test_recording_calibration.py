@@ -12,14 +12,19 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
+
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from rigs import paper_rig_path  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
 PAPER = os.path.join(SOURCE, "graphs", "paper.json")
 MOVED_RIG = os.path.join(SOURCE, "tests", "graphs", "moved_rig.calib.json")
-PAPER_RIG = os.path.join(SOURCE, "calib", "paper_rig.calib.json")
+PAPER_RIG = paper_rig_path()
 FRAMES = 3
 
 

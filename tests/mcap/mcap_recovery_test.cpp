@@ -390,5 +390,25 @@ TEST_F(McapRecoveryTest, ImagesInAnotherEncodingFailBeforeTheGraphRuns) {
       << error;
 }
 
+// `info` prints log times as UTC with milliseconds (truncated, as a clock shows them), and
+// none for a recording without messages.
+TEST(McapRecordingInfo, LogTimesAreUtcWithMilliseconds) {
+  EXPECT_EQ(mcap::utc_time_text(0), "1970-01-01T00:00:00.000Z");
+  EXPECT_EQ(mcap::utc_time_text(1'763'800'000'002'000'000), "2025-11-22T08:26:40.002Z");
+  EXPECT_EQ(mcap::utc_time_text(1'795'594'672'123'999'999), "2026-11-25T08:17:52.123Z");
+  EXPECT_EQ(mcap::utc_time_text(1'709'251'199'999'999'999), "2024-02-29T23:59:59.999Z");
+
+  mcap::RecordingInfo info;
+  EXPECT_NE(mcap::format_info(info).find("\nduration:    0.000 s\n"), std::string::npos)
+      << mcap::format_info(info);
+  info.message_count = 2;
+  info.start_time_ns = 1'763'800'000'002'000'000;
+  info.end_time_ns = 1'763'800'000'302'000'000;
+  EXPECT_NE(mcap::format_info(info).find("\nduration:    0.300 s (log time "
+                                         "2025-11-22T08:26:40.002Z to 2025-11-22T08:26:40.302Z)\n"),
+            std::string::npos)
+      << mcap::format_info(info);
+}
+
 }  // namespace
 }  // namespace tilth::testing

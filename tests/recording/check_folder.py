@@ -12,6 +12,7 @@ import json
 import os
 import struct
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -20,8 +21,11 @@ import zlib
 import cv2
 import numpy as np
 
+SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
+sys.path.insert(0, SUPPORT)
+from rigs import paper_rig_path  # noqa: E402
+
 TILTH = os.environ["TILTH_BIN"]
-SOURCE = os.environ["TILTH_SOURCE_DIR"]
 
 HEADER = ["index", "depth_timestamp_ns", "color_timestamp_ns", "depth", "color", "mask",
           "ground_truth_mm"]
@@ -77,7 +81,7 @@ def read_png(path):
 
 
 def small_calibration():
-    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
+    with open(paper_rig_path()) as f:
         calibration = json.load(f)
     # The principal points move with the sizes: a calibration's must lie inside its image.
     calibration["depth_camera"].update(width=20, height=16, cx=9.5, cy=7.5)

@@ -19,10 +19,9 @@ from check_folder import PNG_GRAY, PNG_RGB, make_frames, read_png, small_calibra
 
 SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
 sys.path.insert(0, SUPPORT)
-from rigs import quarter_rig  # noqa: E402
+from rigs import paper_rig_path, quarter_rig  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
-SOURCE = os.environ["TILTH_SOURCE_DIR"]
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
@@ -247,6 +246,11 @@ class Recording(unittest.TestCase):
                          [(frame["index"], frame["host_ns"]) for frame in frames])
         self.assertEqual(read_bytes(self.path("out/host_timestamps.csv")),
                          read_bytes(os.path.join(source, "host_timestamps.csv")))
+        # The log times are printed in UTC with milliseconds; the latest is frame 3's host
+        # time (1_763_800_000.10045 s).
+        info = tilth("recording", "info", self.path("in.mcap")).stdout
+        self.assertRegex(info, r"\nduration:    \d+\.\d{3} s \(log time "
+                               r"2025-11-22T08:26:\d\d\.\d{3}Z to 2025-11-22T08:26:40\.100Z\)\n")
 
     def test_no_output_is_written_over_its_input_or_anything_but_a_recording(self):
         calibration = small_calibration()
@@ -331,7 +335,7 @@ class Recording(unittest.TestCase):
         self.assertIn(folder + "/recording.json:/calibration: missing required field", result.stderr)
         with open(os.path.join(folder, "recording.json"), "w") as f:
             json.dump({"format": "tilth-image-folder/1", "color_format": "bgr8",
-                       "calibration": os.path.join(SOURCE, "calib", "paper_rig.calib.json")}, f)
+                       "calibration": paper_rig_path()}, f)
         result = tilth("recording", "import", folder, self.path("x.mcap"), "--compression", "zip")
         self.assertEqual(result.returncode, 2)
         self.assertIn("tilth recording import:--compression: parameter 'compression': expected one "

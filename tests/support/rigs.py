@@ -5,9 +5,14 @@ import os
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
+def paper_rig_path():
+    """calib/paper_rig.calib.json: the paper's rig, the default of every graph."""
+    return os.path.join(SOURCE, "calib", "paper_rig.calib.json")
+
+
 def quarter_rig(folder):
     """The paper's rig at a quarter of its resolution: fast to simulate, same views."""
-    with open(os.path.join(SOURCE, "calib", "paper_rig.calib.json")) as f:
+    with open(paper_rig_path()) as f:
         rig = json.load(f)
     for camera in (rig["depth_camera"], rig["color_camera"]):
         camera["width"] //= 4
