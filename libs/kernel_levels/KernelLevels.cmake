@@ -1,17 +1,19 @@
 # tilth_add_kernel_levels(NAME SOURCES src... DISPATCH src... [LIBRARIES lib...])
 # Builds the static library NAME from SOURCES compiled once per instruction-set level --
-# the baseline (on x86-64, -march=x86-64: SSE2) and x86-64-v2 (SSE4.2), x86-64-v3 (AVX2,
-# FMA) and x86-64-v4 (AVX-512), each with -march=<level> -- and DISPATCH, compiled once, which picks among
-# them (kernel_levels/kernel_levels.h). SOURCES see TILTH_KERNEL_LEVEL, the level's namespace
-# (baseline, x86_64_v2, ...), and TILTH_KERNEL_LEVEL_NAME, its name; DISPATCH sees
-# TILTH_KERNEL_LEVELS_X86_64 where the x86-64 levels are built. Internal to this tree.
+# the baseline (on x86-64, -march=x86-64: SSE2) and, on x86-64, x86-64-v3 (AVX2, FMA; with
+# -march=x86-64-v3) -- and DISPATCH, compiled once, which picks between them
+# (kernel_levels/kernel_levels.h). Only these two: x86-64-v2 and x86-64-v4 (AVX-512, rare
+# on industrial PCs) paid less than 10 % on the whole chain (bench/RESULTS.md). SOURCES see
+# TILTH_KERNEL_LEVEL, the level's namespace (baseline, x86_64_v3), and
+# TILTH_KERNEL_LEVEL_NAME, its name; DISPATCH sees TILTH_KERNEL_LEVELS_X86_64 where the
+# x86-64 level is built. Internal to this tree.
 function(tilth_add_kernel_levels name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DISPATCH;LIBRARIES" ${ARGN})
   set(levels baseline)
   set(x86_64 FALSE)
   if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64)$")
     set(x86_64 TRUE)
-    list(APPEND levels x86-64-v2 x86-64-v3 x86-64-v4)
+    list(APPEND levels x86-64-v3)
   endif()
   set(objects)
   set(targets ${name})

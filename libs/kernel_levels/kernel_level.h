@@ -9,12 +9,10 @@
 
 namespace tilth {
 
-#if defined(__AVX512F__)
-constexpr int kKernelLanes = 16;
-#elif defined(__AVX__)
+#if defined(__AVX2__)
 constexpr int kKernelLanes = 8;
 #else
-constexpr int kKernelLanes = 4;  // SSE2, SSE4.2, NEON
+constexpr int kKernelLanes = 4;  // SSE2, NEON
 #endif
 
 }  // namespace tilth

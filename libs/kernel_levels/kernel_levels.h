@@ -1,9 +1,10 @@
 // Kernels compiled once per instruction-set level (tilth_add_kernel_levels in
 // KernelLevels.cmake), and the choice among them when a stage starts: the widest level
 // this CPU runs, or one named by hand for comparisons. So one build runs on
-// any x86-64 PC and still uses AVX-512 where there is one.
+// any x86-64 PC and still uses AVX2 where there is one.
 #pragma once
 
+#include <cstdlib>
 #include <initializer_list>
 #include <span>
 #include <string>
@@ -14,18 +15,29 @@
 
 namespace tilth {
 
-// Whether this CPU runs the instruction-set level `level` ("baseline", "x86-64-v2",
-// "x86-64-v3", "x86-64-v4"); false for names it does not know.
+// Whether this CPU runs the instruction-set level `level` ("baseline", "x86-64-v3");
+// false for names it does not know.
 bool cpu_runs_level(std::string_view level);
 
 // Kernels: a struct of one level's functions with `const char* level`, its name.
 template <class Kernels>
 class KernelLevels {
  public:
-  // Every level built, widest first.
+  // Every level built, widest first. The environment variable TILTH_KERNEL_LEVEL, when
+  // set to a level's name, leaves out the levels wider than it (for comparisons of whole
+  // graphs or benchmarks); any other value is an error.
   explicit KernelLevels(std::initializer_list<const Kernels*> built) : built_(built) {
+    const char* const widest = std::getenv("TILTH_KERNEL_LEVEL");
+    bool allowed = widest == nullptr;
     for (const Kernels* kernels : built_) {
-      if (cpu_runs_level(kernels->level)) runnable_.push_back(kernels);
+      allowed = allowed || kernels->level == std::string_view(widest);
+      if (allowed && cpu_runs_level(kernels->level)) runnable_.push_back(kernels);
+    }
+    if (!allowed) {
+      std::string names;
+      for (const Kernels* kernels : built_) names += std::string(", ") + kernels->level;
+      throw Error("TILTH_KERNEL_LEVEL is '" + std::string(widest) +
+                  "', not a level built: " + names.substr(2));
     }
   }
 
@@ -65,21 +77,14 @@ class KernelLevels {
 // widest first.
 #ifdef TILTH_KERNEL_LEVELS_X86_64
 #define TILTH_KERNEL_LEVELS(Kernels, symbol, name)                                             \
-  namespace x86_64_v4 {                                                                        \
-  extern const Kernels symbol;                                                                 \
-  }                                                                                            \
   namespace x86_64_v3 {                                                                        \
-  extern const Kernels symbol;                                                                 \
-  }                                                                                            \
-  namespace x86_64_v2 {                                                                        \
   extern const Kernels symbol;                                                                 \
   }                                                                                            \
   namespace baseline {                                                                         \
   extern const Kernels symbol;                                                                 \
   }                                                                                            \
   const ::tilth::KernelLevels<Kernels>& name() {                                               \
-    static const ::tilth::KernelLevels<Kernels> levels{&x86_64_v4::symbol, &x86_64_v3::symbol, \
-                                                       &x86_64_v2::symbol, &baseline::symbol}; \
+    static const ::tilth::KernelLevels<Kernels> levels{&x86_64_v3::symbol, &baseline::symbol}; \
     return levels;                                                                             \
   }
 #else

@@ -85,11 +85,10 @@ struct LocatedRow {
 
 // What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
 // colour camera sees them, and the demosaiced colour image for bilinear sampling of a
-// mosaic. The second pass needs each row's locations again: with 16 lanes a vector
-// projecting and locating the row anew costs less than the memory traffic of keeping
-// every row's (12 bytes a pixel, 3.7 MB a frame), with 8 or 4 it costs more
-// (RowKernels::locate_again). Kept rows include their colour pixels for bilinear
-// sampling only, which reads them in the second pass.
+// mosaic. The first pass keeps every row's locations for the second (12 bytes a pixel,
+// 3.7 MB a frame: with 8 or 4 lanes, projecting and locating the rows anew costs more);
+// kept rows include their colour pixels for bilinear sampling only, which reads them in
+// the second pass.
 struct Scratch {
   // An empty cell's depth: the float whose bytes are all kFarByte, 3.4e38 mm, farther
   // than any point.
@@ -99,32 +98,31 @@ struct Scratch {
   std::vector<float> color_u, color_v, color_depth;
   std::vector<int> key, cell;
   cv::Mat demosaiced;  // CV_8UC3
-  bool keep_rows = false;
 
   void prepare(const DepthToColor& map, const OcclusionCells& cells, bool bilinear) {
-    keep_rows = !map.kernels().locate_again;
     const auto row = static_cast<std::size_t>(map.row_capacity());
     const auto frame = row * static_cast<std::size_t>(map.depth_height());
-    for (auto* values : {&color_u, &color_v}) values->resize(keep_rows && bilinear ? frame : row);
-    color_depth.resize(keep_rows ? frame : row);
-    for (auto* values : {&key, &cell}) values->resize(keep_rows ? frame : row);
+    for (auto* values : {&color_u, &color_v}) values->resize(bilinear ? frame : row);
+    color_depth.resize(frame);
+    for (auto* values : {&key, &cell}) values->resize(frame);
     // Cleared to kFar with memset, the fastest way to clear it.
     nearest_mm.resize(static_cast<std::size_t>(cells.grid().count()));
     std::memset(nearest_mm.data(), kFarByte, nearest_mm.size() * sizeof(float));
   }
 
-  // The first pass: projects depth row `v` and finds each point's cell and, when the row
-  // is kept, the pixels for the sampler.
+  // The first pass: projects depth row `v` and finds each point's cell and the pixels for
+  // the sampler, kept for the second pass.
   LocatedRow locate_first(const DepthToColor& map, const OcclusionCells& cells,
                           const cv::Mat& depth, int v, const Addressing& addressing) {
-    return locate(map, cells, depth, v, addressing, !keep_rows);
+    const Slots row = slots(map, v);
+    map.project_row(v, depth.ptr<float>(v), row.u, row.v, row.depth_mm);
+    map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
+                         map.row_capacity(), row.u, row.v, row.depth_mm, row.key, row.cell);
+    return row.located();
   }
 
-  // The second pass: row `v` as kept, or located again.
-  LocatedRow locate_second(const DepthToColor& map, const OcclusionCells& cells,
-                           const cv::Mat& depth, int v, const Addressing& addressing) {
-    return keep_rows ? slots(map, v).located() : locate(map, cells, depth, v, addressing, false);
-  }
+  // The second pass: row `v` as the first kept it.
+  LocatedRow locate_second(const DepthToColor& map, int v) { return slots(map, v).located(); }
 
  private:
   struct Slots {
@@ -134,19 +132,9 @@ struct Scratch {
     LocatedRow located() const { return {u, v, depth_mm, key, cell}; }
   };
 
-  LocatedRow locate(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                    int v, const Addressing& addressing, bool cells_only) {
-    const Slots row = slots(map, v);
-    map.project_row(v, depth.ptr<float>(v), row.u, row.v, row.depth_mm);
-    map.kernels().locate(addressing, cells.grid(), map.color_width(), map.color_height(),
-                         map.row_capacity(), row.u, row.v, row.depth_mm,
-                         cells_only ? nullptr : row.key, row.cell);
-    return row.located();
-  }
-
   Slots slots(const DepthToColor& map, int v) {
     const auto capacity = static_cast<std::size_t>(map.row_capacity());
-    const std::size_t start = keep_rows ? static_cast<std::size_t>(v) * capacity : 0;
+    const std::size_t start = static_cast<std::size_t>(v) * capacity;
     const std::size_t uv = color_u.size() > start ? start : 0;
     return {color_u.data() + uv, color_v.data() + uv, color_depth.data() + start,
             key.data() + start, cell.data() + start};
@@ -182,7 +170,7 @@ void register_nearest(const DepthToColor& map, const OcclusionCells& cells, cons
   fill_z_buffer(map, cells, depth, pixels.addressing, false, scratch);
   const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
   for (int v = rows.first; v < rows.last; ++v) {
-    const LocatedRow row = scratch.locate_second(map, cells, depth, v, pixels.addressing);
+    const LocatedRow row = scratch.locate_second(map, v);
     map.kernels().resolve(seen, pixels.word, map.depth_width(), depth.ptr<float>(v), row.depth_mm,
                           row.cell, row.key, out.status.ptr<std::uint8_t>(v),
                           out.bgr.ptr<std::uint8_t>(v));
@@ -224,7 +212,7 @@ void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, con
   const int color_width = map.color_width();
   const int color_height = map.color_height();
   for (int v = rows.first; v < rows.last; ++v) {
-    const LocatedRow row = scratch.locate_second(map, cells, depth, v, colors.addressing());
+    const LocatedRow row = scratch.locate_second(map, v);
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);

@@ -9,7 +9,7 @@
 #include <limits>
 #include <utility>
 
-#if defined(__AVX__)
+#if defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -53,31 +53,21 @@ constexpr Vector lanes_of(Lane lane) {
   return lanes_of<Vector>(lane, std::make_index_sequence<kCount>());
 }
 
-// With AVX2 and AVX-512, the second pass is vectors (resolve_vectors); below, one pixel
-// at a time (resolve_pixels).
+// With AVX2 the second pass is vectors (resolve_vectors); below, one pixel at a time
+// (resolve_pixels).
 #if defined(__AVX2__)
 // base[index] for each lane; the 32-bit words at base + offset. (The masked gathers,
 // from zeros: GCC 12's unmasked ones start from an undefined vector and warn.)
 [[gnu::always_inline]] inline void gather(Floats& values, const float* base, const Ints& index) {
-#if defined(__AVX512F__)
-  values = reinterpret_cast<Floats>(_mm512_mask_i32gather_ps(
-      _mm512_setzero_ps(), 0xffff, reinterpret_cast<__m512i>(index), base, 4));
-#else
   const __m256 all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   values = reinterpret_cast<Floats>(_mm256_mask_i32gather_ps(
       _mm256_setzero_ps(), base, reinterpret_cast<__m256i>(index), all, 4));
-#endif
 }
 [[gnu::always_inline]] inline void gather_words(Words& words, const std::uint8_t* base,
                                                 const Ints& offset) {
-#if defined(__AVX512F__)
-  words = reinterpret_cast<Words>(_mm512_mask_i32gather_epi32(
-      _mm512_setzero_si512(), 0xffff, reinterpret_cast<__m512i>(offset), base, 1));
-#else
   words = reinterpret_cast<Words>(
       _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(base),
                                   reinterpret_cast<__m256i>(offset), _mm256_set1_epi32(-1), 1));
-#endif
 }
 #endif
 
@@ -85,11 +75,7 @@ constexpr Vector lanes_of(Lane lane) {
 // the hardware's estimate, refined by one Newton-Raphson step, takes 3 instructions. x =
 // 0 gives NaN, where the division gives infinity; the projection does not show either.
 [[gnu::always_inline]] inline Floats reciprocal(const Floats& x) {
-#if defined(__AVX512F__)
-  const Floats estimate =
-      reinterpret_cast<Floats>(_mm512_maskz_rcp14_ps(0xffff, reinterpret_cast<__m512>(x)));
-  return estimate * (2.0f - x * estimate);
-#elif defined(__AVX__)
+#if defined(__AVX2__)
   const Floats estimate = reinterpret_cast<Floats>(_mm256_rcp_ps(reinterpret_cast<__m256>(x)));
   return estimate * (2.0f - x * estimate);
 #else
@@ -172,40 +158,6 @@ void project(const ProjectionModel& m, const float* xs, const float* ys, float r
   };
   ys == nullptr ? run.template operator()<true>() : run.template operator()<false>();
 }
-
-#if defined(__AVX512F__)
-// The nearest point of each cell: nearest_mm[cell] = min(nearest_mm[cell], depth) for
-// each point. Neighbouring points mostly share a cell, and a store followed by a load of
-// the same cell waits for the store. So each run of lanes with one cell first takes its
-// minimum in the vector (the lanes before each lane, 1, 2, 4, ... back, that share its
-// cell), and its last lane alone writes the cell. The writes are compressed into
-// `written` and `mins` (room for kLanes) and applied a chunk later, because a load of a
-// lane just stored from a vector would wait for the store. Returns the number of writes.
-[[gnu::always_inline]] inline int run_minimums(const Ints& cell, const Floats& depth,
-                                               const Ints& outside, int* written, float* mins) {
-  Floats run_min = depth;
-  const auto step_back = [&]<int kStep>() {
-    constexpr Ints kBack =
-        lanes_of<Ints>([](int lane) { return lane >= kStep ? lane - kStep : lane; });
-    const Ints earlier_cell = __builtin_shuffle(cell, kBack);
-    const Floats earlier_min = __builtin_shuffle(run_min, kBack);
-    run_min = (earlier_cell == cell) & (earlier_min < run_min) ? earlier_min : run_min;
-  };
-  step_back.template operator()<1>();
-  step_back.template operator()<2>();
-  step_back.template operator()<4>();
-  step_back.template operator()<8>();
-  constexpr Ints kNext =
-      lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? lane + 1 : lane; });
-  constexpr Ints kLast = lanes_of<Ints>([](int lane) { return lane + 1 < kLanes ? 0 : -1; });
-  // The outside cell's points have NaN depth: no write changes it.
-  const Ints writes = ((__builtin_shuffle(cell, kNext) != cell) | kLast) & (cell != outside);
-  const __mmask16 lanes = _mm512_movepi32_mask(reinterpret_cast<__m512i>(writes));
-  _mm512_storeu_si512(written, _mm512_maskz_compress_epi32(lanes, reinterpret_cast<__m512i>(cell)));
-  _mm512_storeu_ps(mins, _mm512_maskz_compress_ps(lanes, reinterpret_cast<__m512>(run_min)));
-  return __builtin_popcount(lanes);
-}
-#endif
 
 // How a pixel word holds its colour: as blue | green << 8 | red << 16 already (bgr8), as
 // one pixel's bytes in any order, or as a 2x2 quad.
@@ -425,10 +377,7 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
     yf = yf < y_end ? yf : y_end;
     const Ints x = __builtin_convertvector(xf, Ints) - 1;
     const Ints y = __builtin_convertvector(yf, Ints) - 1;
-    if (keys != nullptr) {
-      store(keys + i,
-            y * row_key + x * column_key + (-(y & 1) & odd_row) + (-(x & 1) & odd_column));
-    }
+    store(keys + i, y * row_key + x * column_key + (-(y & 1) & odd_row) + (-(x & 1) & odd_column));
     // Shown points have -0.5 <= u < width - 0.5: u + 0.5 truncates to its floor. A point
     // not shown (NaN) converts to INT_MIN, whose product with the columns overflows: the
     // cell is computed in unsigned (wrapping) arithmetic and replaced by the outside cell.
@@ -440,33 +389,8 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
   }
 }
 
-#if defined(__AVX512F__)
-void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
-                  const int* cell_indices, float* nearest_mm) {
-  const Ints outside = Ints{} + cells.outside;
-  constexpr int kChunk = 256;
-  static_assert(kChunk % kRowLanes == 0);
-  int written[kChunk + kLanes];
-  float mins[kChunk + kLanes];
-  for (int chunk = 0; chunk < count; chunk += kChunk) {
-    const int end = count - chunk < kChunk ? count : chunk + kChunk;
-    int listed = 0;
-    for (int i = chunk; i < end; i += kLanes) {
-      Floats depth;
-      Ints cell;
-      load(depth, color_depth + i);
-      load(cell, cell_indices + i);
-      listed += run_minimums(cell, depth, outside, written + listed, mins + listed);
-    }
-    for (int i = 0; i < listed; ++i) {
-      float& nearest = nearest_mm[written[i]];
-      nearest = mins[i] < nearest ? mins[i] : nearest;
-    }
-  }
-}
-#else
-// Below AVX-512 one point at a time: without the compress, listing a vector's runs costs
-// more than waiting for a neighbour's store (measured). NaN depth leaves a cell as it was.
+// One point at a time: listing a vector's runs of points that share a cell costs more
+// than waiting for a neighbour's store (measured). NaN depth leaves a cell as it was.
 void keep_nearest(const CellGrid&, int count, const float* color_depth, const int* cell_indices,
                   float* nearest_mm) {
   for (int i = 0; i < count; ++i) {
@@ -474,12 +398,10 @@ void keep_nearest(const CellGrid&, int count, const float* color_depth, const in
     nearest = color_depth[i] < nearest ? color_depth[i] : nearest;
   }
 }
-#endif
 
 }  // namespace
 
-// With 16 lanes, locating a row again costs less than keeping it (measured; see Scratch).
-extern const RowKernels kRowKernels{project, locate,       keep_nearest,
-                                    resolve, kLanes >= 16, TILTH_KERNEL_LEVEL_NAME};
+extern const RowKernels kRowKernels{project, locate, keep_nearest, resolve,
+                                    TILTH_KERNEL_LEVEL_NAME};
 
 }  // namespace tilth::registration::TILTH_KERNEL_LEVEL

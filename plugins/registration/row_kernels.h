@@ -2,9 +2,9 @@
 // colour camera; finding each point's colour pixels and z-buffer cell and keeping the
 // nearest point of each cell; and, once every row is in the z-buffer, each point's status
 // and nearest-sampled colour.
-// row_kernels.cpp is compiled once per x86-64 level (baseline SSE2, v2 = SSE4.2, v3 =
-// AVX2 + FMA, v4 = AVX-512) and row_kernels() picks the best the CPU runs, so the plugin runs on
-// any x86-64 PC yet uses the widest vectors there are; other architectures get their baseline.
+// row_kernels.cpp is compiled for the x86-64 baseline (SSE2) and x86-64-v3 (AVX2 + FMA),
+// and row_kernels() picks the best the CPU runs, so the plugin runs on any x86-64 PC yet
+// uses AVX2 where there is one; other architectures get their baseline.
 #pragma once
 
 #include <array>
@@ -65,7 +65,7 @@ struct RowKernels {
                   const float* z_mm, float* color_u, float* color_v, float* color_depth);
   // For `count` projected points (a multiple of kRowLanes): the key of the pixels
   // nearest sampling reads (Addressing; clamped to the image, so that a point not shown
-  // reads pixels too; keys may be null) and the cell.
+  // reads pixels too) and the cell.
   void (*locate)(const Addressing& addressing, const CellGrid& cells, int color_width,
                  int color_height, int count, const float* color_u, const float* color_v,
                  const float* color_depth, int* keys, int* cell_indices);
@@ -81,10 +81,7 @@ struct RowKernels {
   void (*resolve)(const Visibility& visibility, const PixelWord& pixels, int count,
                   const float* z_mm, const float* color_depth, const int* cell_indices,
                   const int* keys, std::uint8_t* status, std::uint8_t* bgr);
-  // Whether the second pass projects and locates the rows again rather than keeping
-  // every row's locations from the first (see the registration's Scratch).
-  bool locate_again;
-  const char* level;  // "x86-64-v4", ...
+  const char* level;  // "x86-64-v3", "baseline"
 };
 
 // "auto" and the names of the levels built, widest first.

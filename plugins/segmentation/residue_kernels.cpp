@@ -16,9 +16,6 @@
 #include "residue_kernels.h"
 #include "tilth/messages/residue_mask.h"
 
-#if defined(__AVX512F__) && !defined(__AVX512BW__)
-#error "AVX-512 without its byte and word instructions (BW): no level of x86-64 is so"
-#endif
 static_assert(std::endian::native == std::endian::little, "a pixel's bytes are read as a word");
 
 namespace tilth::segmentation::TILTH_KERNEL_LEVEL {
@@ -52,37 +49,6 @@ constexpr int kPixelsPerLookup = kLanes;
   return _mm_setr_epi8(0, 1, 2, -1, 3, 4, 5, -1, 6, 7, 8, -1, 9, 10, 11, -1);
 }
 
-#if defined(__AVX512BW__)
-using Words = __m512i;
-
-// The words of `lanes` <= kLanes pixels from bgr on, reading no byte beyond them. (The
-// masked forms, from zeros: GCC 12's unmasked ones start from an undefined vector and
-// warn.)
-[[gnu::always_inline]] inline Words pixel_words(const std::uint8_t* bgr, int lanes) {
-  const __mmask64 bytes = (std::uint64_t{1} << (3 * lanes)) - 1;
-  const __m512i raw = _mm512_maskz_loadu_epi8(bytes, bgr);
-  const __m512i spread = _mm512_maskz_permutexvar_epi32(
-      0xffff, _mm512_setr_epi32(0, 1, 2, 0, 3, 4, 5, 0, 6, 7, 8, 0, 9, 10, 11, 0), raw);
-  return _mm512_shuffle_epi8(spread, _mm512_maskz_broadcast_i32x4(0xffff, spread_in_lane()));
-}
-
-[[gnu::always_inline]] inline std::uint64_t runs_contain(const BlueRun* runs, const Words& words) {
-  const __m512i run = _mm512_mask_i32gather_epi32(
-      _mm512_setzero_si512(), 0xffff, _mm512_maskz_srli_epi32(0xffff, words, 8), runs, 2);
-  const __m512i byte = _mm512_set1_epi32(0xff);
-  const __m512i blue = _mm512_and_si512(words, byte);
-  const __m512i first = _mm512_and_si512(run, byte);
-  const __m512i last = _mm512_and_si512(_mm512_maskz_srli_epi32(0xffff, run, 8), byte);
-  return _mm512_mask_cmple_epu32_mask(_mm512_cmple_epu32_mask(first, blue), blue, last);
-}
-
-[[gnu::always_inline]] inline std::uint64_t table_contains(const std::uint8_t* table,
-                                                           const Words& words) {
-  const __m512i entry =
-      _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xffff, words, table, 1);
-  return _mm512_test_epi32_mask(entry, _mm512_set1_epi32(0xff));
-}
-#else
 using Words = __m256i;
 
 [[gnu::always_inline]] inline Words pixel_words(const std::uint8_t* bgr, int lanes) {
@@ -121,7 +87,6 @@ using Words = __m256i;
       _mm256_cmpeq_epi32(_mm256_and_si256(entry, _mm256_set1_epi32(0xff)), _mm256_setzero_si256());
   return static_cast<std::uint8_t>(~_mm256_movemask_ps(_mm256_castsi256_ps(out)));
 }
-#endif
 
 #else
 // Without gathers: a pixel at a time, its bytes where they are.

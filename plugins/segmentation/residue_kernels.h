@@ -27,7 +27,7 @@ struct ResidueKernels {
   // `unknown` and `residue` hold (cols + 63) / 64 words.
   void (*write_residue_row)(const std::uint64_t* unknown, const std::uint64_t* residue,
                             const float* depth_mm, int cols, std::uint8_t* mask, float* soil_mm);
-  const char* level;  // "x86-64-v4", ...
+  const char* level;  // "x86-64-v3", "baseline"
 };
 
 // The levels this CPU runs, widest first: the stages use the first.
