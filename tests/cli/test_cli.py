@@ -48,6 +48,20 @@ class HelpAndInspection(unittest.TestCase):
         self.assertEqual(wrong.returncode, 2)
         self.assertIn("tilth: unknown command 'valdate'; did you mean 'validate'?", wrong.stderr)
 
+    def test_misspelt_subcommands_and_options_get_suggestions(self):
+        for args, expected in (
+                (("recording", "inf", "x.mcap"), "unknown command 'inf'; did you mean 'info'?"),
+                (("calibrate", "slove"), "unknown command 'slove'; did you mean 'solve'?"),
+                (("run", "g.json", "--frame", "3"),
+                 "unknown option --frame; did you mean '--frames'? (see --help)"),
+                (("doctor", "--jsn"), "unknown option --jsn; did you mean '--json'? (see --help)"),
+                (("simulate", "out", "--preset", "case_c", "--frame", "2"),
+                 "did you mean '--frames'?")):
+            with self.subTest(args=args):
+                result = tilth(*args)
+                self.assertEqual(result.returncode, 2, result.stderr)
+                self.assertIn(expected, result.stderr)
+
     def test_plugins_lists_types_with_ports(self):
         result = tilth("plugins")
         self.assertEqual(result.returncode, 0, result.stderr)

@@ -24,6 +24,7 @@
 #include "check_report.h"
 #include "command_line.h"
 #include "commands.h"
+#include "framework/nearest_names.h"
 #include "rig_facts.h"
 #include "rig_solver.h"
 #include "solve_report.h"
@@ -508,7 +509,8 @@ int main(int argc, char** argv) {
     if (command == "import") return import(line);
     if (command == "check") return check(line);
     if (command == "capture") return capture(line);
-    return usage_error("unknown command '" + command + "'");
+    return usage_error("unknown command '" + command + "'" +
+                       tilth::did_you_mean(command, {"solve", "import", "check", "capture"}));
   } catch (const std::exception& error) {
     std::cerr << "tilth calibrate: " << error.what() << "\n";
     return kExitFailed;

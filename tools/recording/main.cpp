@@ -13,6 +13,7 @@
 #include "conversion.h"
 #include "data_loss_report.h"
 #include "framework/diagnostics.h"
+#include "framework/nearest_names.h"
 #include "mcap/mcap_recording.h"
 #include "output_path.h"
 #include "stop_signals.h"
@@ -149,7 +150,8 @@ int main(int argc, char** argv) {
     if (command == "info") return info(line);
     if (command == "repair") return repair(line);
     if (command == "export" || command == "import") return convert(line);
-    return usage_error("unknown command '" + command + "'");
+    return usage_error("unknown command '" + command + "'" +
+                       tilth::did_you_mean(command, {"info", "repair", "export", "import"}));
   } catch (const tilth::GraphError& error) {
     std::cerr << error.what() << "\n";
     return kExitUsage;

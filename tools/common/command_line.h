@@ -14,7 +14,8 @@ namespace tilth::cli {
 class CommandLine {
  public:
   // `valued` options take the next argument (--set k=v); `flags` take none; -h is --help
-  // where --help is a flag. Throws tilth::Error for an unknown option or a missing value.
+  // where --help is a flag. Throws tilth::Error for an unknown option (with the nearest
+  // known ones) or a missing value.
   CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
               const std::set<std::string>& flags);
 

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <sstream>
 
+#include "framework/nearest_names.h"
 #include "tilth/error.h"
 
 namespace tilth::cli {
@@ -48,7 +49,9 @@ CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::s
     } else if (arg == "-h" && flags.count("--help")) {
       flags_.insert("--help");
     } else if (arg.starts_with("-") && arg != "-") {
-      throw Error("unknown option " + arg + " (see --help)");
+      std::vector<std::string> known(valued.begin(), valued.end());
+      known.insert(known.end(), flags.begin(), flags.end());
+      throw Error("unknown option " + arg + did_you_mean(arg, known) + " (see --help)");
     } else {
       positional_.push_back(arg);
     }
