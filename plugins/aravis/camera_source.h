@@ -8,9 +8,9 @@
 #include <memory>
 #include <string>
 
-#include "camera_session.h"
-#include "frame_layout.h"
-#include "recycling_allocator.h"
+#include "aravis/camera_session.h"
+#include "aravis/frame_layout.h"
+#include "aravis/recycling_allocator.h"
 #include "tilth/message_pool.h"
 #include "tilth/messages/camera_status.h"
 #include "tilth/stage.h"

@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "frame_counters.h"
-#include "frame_layout.h"
-#include "pixel_formats.h"
-#include "recycling_allocator.h"
+#include "aravis/frame_counters.h"
+#include "aravis/frame_layout.h"
+#include "aravis/pixel_formats.h"
+#include "aravis/recycling_allocator.h"
 #include "tilth/error.h"
 
 namespace tilth::aravis {

@@ -20,8 +20,8 @@
 
 #include "aravis/gobject_ptr.h"
 #include "fake_camera.h"
-#include "frame_layout.h"
-#include "stream_buffers.h"
+#include "aravis/frame_layout.h"
+#include "aravis/stream_buffers.h"
 #include "tilth/error.h"
 
 namespace tilth::aravis {

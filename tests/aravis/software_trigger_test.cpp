@@ -1,7 +1,7 @@
 // The host clock's trigger grid (software_trigger.h): the instants every camera at one rate
 // is fired at. Firing real cameras is tested against the simulator in
 // test_software_trigger.py.
-#include "software_trigger.h"
+#include "aravis/software_trigger.h"
 
 #include <gtest/gtest.h>
 

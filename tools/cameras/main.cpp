@@ -8,7 +8,7 @@
 
 #include "aravis/device_list.h"
 #include "aravis/gobject_ptr.h"
-#include "camera_features.h"
+#include "aravis/camera_features.h"
 
 namespace {
 
