@@ -4,9 +4,15 @@
 // host capture times of host_timestamps.csv when the folder has one. recording.json, all
 // of frames.csv and host_timestamps.csv are checked before the first frame, whichever
 // host times are used, so a malformed recording fails before the graph runs; the PNGs
-// are read frame by frame. Every file is read only when it is a regular file (a FIFO or
-// a device named in a recording would block the replay) within a size limit.
+// are read frame by frame, `decode_ahead` frames ahead of the graph, each on a thread of
+// its own (decoding PNGs, not the measurement, bounds a replay), and played in order.
+// Every file is read only when it is a regular file (a FIFO or a device named in a
+// recording would block the replay) within a size limit.
+#include <algorithm>
+#include <deque>
+#include <future>
 #include <optional>
+#include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -48,6 +54,13 @@ struct FrameImages {
   cv::Mat mask;  // empty: the frame has no mask
 };
 
+// A frame's images as decoded ahead, or why the frame is skipped (on_missing: skip),
+// logged when the frame's turn comes so that the log keeps the frames' order.
+struct DecodedFrame {
+  std::optional<FrameImages> images;
+  std::string skipped;
+};
+
 class ImageFolderSource final : public Source {
  public:
   explicit ImageFolderSource(const StageContext& context)
@@ -60,6 +73,7 @@ class ImageFolderSource final : public Source {
         clock_(context.params.number("rate")),
         stop_on_missing_(context.params.string("on_missing") == "stop"),
         loop_(context.params.boolean("loop")),
+        decode_ahead_(frames_decoded_ahead(context.params.integer("decode_ahead"))),
         log_(context.log) {}
 
   bool produce(Frame& frame) override {
@@ -71,6 +85,7 @@ class ImageFolderSource final : public Source {
           return false;
         }
         next_ = 0;
+        queued_ = 0;
       }
       if (next_ == 0) {
         clock_.restart();
@@ -79,8 +94,9 @@ class ImageFolderSource final : public Source {
       const std::size_t position = next_++;
       const FrameEntry& entry = frames_[position];
       // Paced by the depth timestamps, relative to the first frame of the pass.
+      queue_ahead(position);
       if (!clock_.wait(entry.depth_timestamp_ns)) return false;
-      if (auto images = read_images(entry)) {
+      if (auto images = take_images(position)) {
         emit(frame, entry, host_timestamp(position), std::move(*images));
         produced_this_pass_ = true;
         return true;
@@ -91,29 +107,62 @@ class ImageFolderSource final : public Source {
   void interrupt() override { clock_.interrupt(); }
 
  private:
-  // The frame's images, checked; nullopt when one is missing or unreadable and
-  // on_missing is skip.
-  std::optional<FrameImages> read_images(const FrameEntry& entry) const {
+  using Decoding = std::future<DecodedFrame>;
+
+  static std::size_t frames_decoded_ahead(std::int64_t asked) {
+    if (asked > 0) return static_cast<std::size_t>(asked);
+    return std::max(1u, std::thread::hardware_concurrency());
+  }
+
+  // Starts decoding the frames after those in ahead_, up to decode_ahead_ frames from
+  // `position` on, within this pass.
+  void queue_ahead(std::size_t position) {
+    while (queued_ < frames_.size() && queued_ < position + decode_ahead_) {
+      const FrameEntry& entry = frames_[queued_++];
+      ahead_.push_back(
+          std::async(std::launch::async, [this, &entry] { return read_images(entry); }));
+    }
+  }
+
+  // The images of the frame at `position`, the oldest decoding; a failure to read them
+  // (on_missing: stop, a wrong size) is thrown here, in the frames' order.
+  std::optional<FrameImages> take_images(std::size_t position) {
+    Decoding decoding = std::move(ahead_.front());
+    ahead_.pop_front();
+    queue_ahead(position + 1);
+    DecodedFrame decoded = decoding.get();
+    if (!decoded.skipped.empty()) log_.warning(decoded.skipped);
+    return std::move(decoded.images);
+  }
+
+  // The frame's images, checked, or why it is skipped when one is missing or unreadable
+  // and on_missing is skip. Runs on the decoding threads: reads only what does not change.
+  DecodedFrame read_images(const FrameEntry& entry) const {
     const cv::Size depth_size(recording_.calibration.depth.width,
                               recording_.calibration.depth.height);
     const cv::Size color_size(recording_.calibration.color.width,
                               recording_.calibration.color.height);
+    DecodedFrame decoded;
     FrameImages images;
-    images.depth = read_image(entry, entry.depth, CV_16UC1, depth_size, "depth_camera");
-    if (images.depth.empty()) return std::nullopt;
+    images.depth =
+        read_image(entry, entry.depth, CV_16UC1, depth_size, "depth_camera", decoded.skipped);
+    if (images.depth.empty()) return decoded;
     images.color = read_image(entry, entry.color, CV_8UC(channels(recording_.color_format)),
-                              color_size, "color_camera");
-    if (images.color.empty()) return std::nullopt;
+                              color_size, "color_camera", decoded.skipped);
+    if (images.color.empty()) return decoded;
     if (!entry.mask.empty()) {
-      images.mask = read_image(entry, entry.mask, CV_8UC1, depth_size, "depth_camera");
-      if (images.mask.empty()) return std::nullopt;
+      images.mask =
+          read_image(entry, entry.mask, CV_8UC1, depth_size, "depth_camera", decoded.skipped);
+      if (images.mask.empty()) return decoded;
     }
-    return images;
+    decoded.images = std::move(images);
+    return decoded;
   }
 
-  // An empty image when the file is missing or unreadable and on_missing is skip.
+  // An empty image, and `skipped` saying why, when the file is missing or unreadable and
+  // on_missing is skip.
   cv::Mat read_image(const FrameEntry& entry, const std::string& relative, int type, cv::Size size,
-                     std::string_view camera) const {
+                     std::string_view camera, std::string& skipped) const {
     const fs::path file = folder_ / relative;
     const std::string where =
         file.string() + " (frames.csv line " + std::to_string(entry.line) + ")";
@@ -138,8 +187,8 @@ class ImageFolderSource final : public Source {
     }
     if (!problem.empty()) {
       if (stop_on_missing_) throw Error(where + ": " + problem + " (on_missing: stop)");
-      log_.warning(where + ": " + problem + "; frame " + std::to_string(entry.index) +
-                   " skipped (on_missing: skip)");
+      skipped = where + ": " + problem + "; frame " + std::to_string(entry.index) +
+                " skipped (on_missing: skip)";
       return {};
     }
     const std::string mismatch =
@@ -181,10 +230,14 @@ class ImageFolderSource final : public Source {
   PlaybackClock clock_;
   const bool stop_on_missing_;
   const bool loop_;
+  const std::size_t decode_ahead_;
   const Logger log_;
 
   std::size_t next_ = 0;  // the next entry of frames_
   bool produced_this_pass_ = false;
+  std::size_t queued_ = 0;      // the entry after the last one decoding
+  std::deque<Decoding> ahead_;  // entries [next_ or the one being played, queued_); last:
+                                // destroyed first, each waiting for its decoding to end
 };
 
 StageDescriptor describe() {
@@ -208,6 +261,10 @@ StageDescriptor describe() {
       ParamSpec::choice("on_missing", {"skip", "stop"}, "skip")
           .describe("a missing or unreadable PNG: skip the frame with a warning, or stop"),
       ParamSpec::boolean("loop", false).describe("start again after the last frame"),
+      ParamSpec::integer("decode_ahead", 0)
+          .range(0, 64)
+          .describe("frames read and decoded ahead of the graph, each on a thread of its "
+                    "own; 0 = as many as the machine has cores"),
       ReplayHostTime::param("host_timestamps.csv's, or when played without it"),
   };
   d.concurrency = Concurrency::kSerial;

@@ -491,6 +491,39 @@ TEST_F(ImageFolderSourceTest, MissingOrUnreadablePngSkipsTheFrameWithAWarning) {
   EXPECT_EQ(logged, expected);
 }
 
+// Decoded up to 8 frames ahead on threads of their own, the frames, their warnings and
+// a failure still come in the recording's order.
+TEST_F(ImageFolderSourceTest, FramesDecodedAheadComeInTheRecordingsOrder) {
+  record(12, 1'000'000);
+  fs::remove(folder_ / "color/000006.png");
+  const RunResult result = run(replay_graph(folder_, {{"decode_ahead", 8}}));
+  ASSERT_FALSE(result.failed) << result.failure;
+  std::vector<std::uint64_t> expected_ids;
+  for (const TestFrame& frame : frames_) {
+    if (frame.index != 6) expected_ids.push_back(frame.index);
+  }
+  ASSERT_EQ(captured_ids(), expected_ids);
+  for (std::size_t i = 0, frame = 0; i < captured_.size(); ++i, ++frame) {
+    if (frames_[frame].index == 6) ++frame;
+    EXPECT_TRUE(same_pixels(frames_[frame].depth, captured_[i].raw->gray)) << "frame " << i;
+    EXPECT_TRUE(same_pixels(frames_[frame].color, captured_[i].color->pixels)) << "frame " << i;
+  }
+  EXPECT_EQ(
+      warnings(),
+      (std::vector<std::string>{"src: " + (folder_ / "color/000006.png").string() +
+                                " (frames.csv line 4): no such file; frame 6 skipped (on_missing: "
+                                "skip)"}));
+
+  write_text(folder_ / "depth/000008.png", "not a PNG");
+  const RunResult stopped =
+      run(replay_graph(folder_, {{"decode_ahead", 8}, {"on_missing", "stop"}}));
+  EXPECT_TRUE(stopped.failed);
+  EXPECT_EQ(stopped.failure, "node 'src' (recording.image_folder) failed: " +
+                                 (folder_ / "color/000006.png").string() +
+                                 " (frames.csv line 4): no such file (on_missing: stop); its "
+                                 "stream ends here");
+}
+
 TEST_F(ImageFolderSourceTest, MissingPngStopsWhenAsked) {
   record(5);
   fs::remove(folder_ / "color/000006.png");
