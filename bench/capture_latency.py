@@ -19,7 +19,6 @@ import argparse
 import json
 import os
 import shutil
-import signal
 import statistics
 import subprocess
 import sys
@@ -30,6 +29,7 @@ SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "support"))
 from fake_gige_camera import FakeCamera  # noqa: E402
 from ports import free_port  # noqa: E402
+from processes import interrupt  # noqa: E402
 from pymodbus_tcp import ModbusTcpClient  # noqa: E402
 
 MAX_LOG_BYTES = 5_000_000
@@ -96,13 +96,7 @@ def run_mode(args, mode, work):
             raise RuntimeError("tilth stopped; its log: " + open(log_path).read()[-3000:])
         return read_ages(port, args.seconds)
     finally:
-        if tilth is not None and tilth.poll() is None:
-            tilth.send_signal(signal.SIGINT)
-            try:
-                tilth.wait(30)
-            except subprocess.TimeoutExpired:
-                tilth.kill()
-                tilth.wait()
+        interrupt(tilth)
         depth.kill()
         color.kill()
 

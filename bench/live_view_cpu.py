@@ -18,7 +18,6 @@ import argparse
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -30,6 +29,7 @@ SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "support"))
 from fake_gige_camera import FakeCamera  # noqa: E402
 from ports import free_port  # noqa: E402
+from processes import interrupt  # noqa: E402
 
 TICKS = os.sysconf("SC_CLK_TCK")
 MAX_LOG_BYTES = 5_000_000
@@ -168,13 +168,7 @@ def main():
                   (viewer.bytes / viewer.images / 1000, viewer.images))
         return 0
     finally:
-        if tilth is not None and tilth.poll() is None:
-            tilth.send_signal(signal.SIGINT)
-            try:
-                tilth.wait(30)
-            except subprocess.TimeoutExpired:
-                tilth.kill()
-                tilth.wait()
+        interrupt(tilth)
         depth.kill()
         color.kill()
         shutil.rmtree(work, ignore_errors=True)

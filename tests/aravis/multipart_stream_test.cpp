@@ -18,10 +18,10 @@
 #include <arv.h>
 #include <gtest/gtest.h>
 
-#include "aravis/gobject_ptr.h"
-#include "fake_camera.h"
 #include "aravis/frame_layout.h"
+#include "aravis/gobject_ptr.h"
 #include "aravis/stream_buffers.h"
+#include "fake_camera.h"
 #include "tilth/error.h"
 
 namespace tilth::aravis {

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "aravis/camera_features.h"
 #include "aravis/device_list.h"
 #include "aravis/gobject_ptr.h"
-#include "aravis/camera_features.h"
 
 namespace {
 
