@@ -74,7 +74,12 @@ class ImageFolderSource final : public Source {
         stop_on_missing_(context.params.string("on_missing") == "stop"),
         loop_(context.params.boolean("loop")),
         decode_ahead_(frames_decoded_ahead(context.params.integer("decode_ahead"))),
-        log_(context.log) {}
+        log_(context.log) {
+    // OpenCV lists its codecs on first use, behind a guard that ThreadSanitizer cannot see
+    // in uninstrumented OpenCV; listing them here, before a decoding thread starts, orders
+    // that listing before every decoding for it too.
+    cv::haveImageWriter(".png");
+  }
 
   bool produce(Frame& frame) override {
     for (;;) {
