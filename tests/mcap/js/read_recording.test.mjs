@@ -17,11 +17,11 @@ import { McapStreamReader } from "@mcap/core";
 import {
   decoderFor, decompressHandlers, messagesOn, openMcap, pngAsRawImageBytes, readPng, stampNs,
 } from "./readers.mjs";
+import { paperRigPath } from "../../support/rigs.mjs";
 
 const TILTH = process.env.TILTH_BIN;
 const RECORDING_TOOL = process.env.TILTH_RECORDING_BIN;
-const SOURCE = process.env.TILTH_SOURCE_DIR;
-const CALIBRATION = path.join(SOURCE, "calib", "paper_rig.calib.json");
+const CALIBRATION = paperRigPath();
 const FRAMES = 3;
 
 // Runs synthetic.scene -> mcap.writer and recording.image_folder_writer once.

@@ -19,9 +19,9 @@ import { test } from "node:test";
 import {
   attachmentsOf, decoderFor, messagesOn, openMcap, pngAsRawImageBytes, readPng, stampNs,
 } from "./readers.mjs";
+import { quarterRig } from "../../support/rigs.mjs";
 
 const TILTH = process.env.TILTH_BIN;
-const SOURCE = process.env.TILTH_SOURCE_DIR;
 const FRAMES = 4;
 const TOPICS = ["/tof/raw", "/color/image", "/truth", "/truth/mask"];
 
@@ -30,19 +30,6 @@ test.after(() => fs.rmSync(dir, { recursive: true, force: true }));
 
 function tilth(...args) {
   return execFileSync(TILTH, args, { encoding: "utf8", stdio: ["ignore", "pipe", "inherit"] });
-}
-
-// The paper's rig at a quarter of its resolution, the same fields of view.
-function quarterRig() {
-  const rig = JSON.parse(fs.readFileSync(path.join(SOURCE, "calib", "paper_rig.calib.json")));
-  for (const camera of [rig.depth_camera, rig.color_camera]) {
-    camera.width /= 4;
-    camera.height /= 4;
-    for (const key of ["fx", "fy", "cx", "cy"]) camera[key] /= 4;
-  }
-  const file = path.join(dir, "quarter.calib.json");
-  fs.writeFileSync(file, JSON.stringify(rig, null, 2));
-  return file;
 }
 
 function readCsv(folder, name) {
@@ -59,7 +46,7 @@ function listFiles(folder) {
 }
 
 async function roundTrip(colorFormat) {
-  const calibration = quarterRig();
+  const calibration = quarterRig(dir);
   const work = path.join(dir, colorFormat);
   fs.mkdirSync(work);
   const first = path.join(work, "simulated.mcap");
