@@ -71,17 +71,25 @@ def convert_to_mcap(folder, mcap):
     run([TILTH, "run", graph, "--quiet"])
 
 
+VARIANTS = os.path.join(FIXTURE, "variants.json")
+
+
+def comparison(out):
+    """The command line of the fixture's comparison of three variants on the recordings
+    (test_shards.py runs it as shards)."""
+    return [TILTH, "ab", RECORDINGS, "--variants", VARIANTS,
+            "--variant", "wide:segment.dilation_px=5",
+            "--variant", "plane:estimate.type=estimation.ground_plane",
+            "--variant", "plane:estimate.calibration=" + CALIBRATION,
+            "--var", "calibration=" + CALIBRATION, "--overlays", "2", "--out", out, "--quiet"]
+
+
 def compare(out, *extra):
-    variants = os.path.join(FIXTURE, "variants.json")
-    with open(variants, "w") as f:
+    with open(VARIANTS, "w") as f:
         json.dump({"variants": [{"name": "threshold",
                                  "description": "the paper's colour threshold, as in the chain"}]},
                   f)
-    return run([TILTH, "ab", RECORDINGS, "--variants", variants,
-                "--variant", "wide:segment.dilation_px=5",
-                "--variant", "plane:estimate.type=estimation.ground_plane",
-                "--variant", "plane:estimate.calibration=" + CALIBRATION,
-                "--var", "calibration=" + CALIBRATION, "--out", out, "--quiet", *extra])
+    return run(comparison(out) + list(extra))
 
 
 def main():
@@ -91,8 +99,8 @@ def main():
     simulate("case_c", 3, case_c)
     hide_truth(case_c, os.path.join(RECORDINGS, "case_c_hidden"))
     convert_to_mcap(case_c, os.path.join(RECORDINGS, "case_c_mcap.mcap"))
-    compare(os.path.join(FIXTURE, "report"), "--keep-images", "--overlays", "2")
-    compare(os.path.join(FIXTURE, "report-serial"), "--jobs", "1", "--overlays", "2")
+    compare(os.path.join(FIXTURE, "report"), "--keep-images")
+    compare(os.path.join(FIXTURE, "report-serial"), "--jobs", "1")
     run([TILTH, "run", os.path.join(SOURCE, "graphs", "paper.json"), "--quiet",
          "--var", "calibration=" + CALIBRATION, "--set", "input.path=" + case_c,
          "--set", "output.path=" + os.path.join(FIXTURE, "paper-case_c.csv")])

@@ -2,6 +2,7 @@
 // the chain's stage times, and the figures derived from them.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct JobResult {
   std::vector<FrameResult> frames;
   std::vector<StageTime> stages;  // the chain's stages, in graph order
   double frames_per_second = 0.0;
+  std::filesystem::path images;  // the images its evaluation sink saved, if it saved them
 };
 
 struct Comparison {

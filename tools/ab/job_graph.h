@@ -22,6 +22,7 @@ struct JobFiles {
   std::filesystem::path graph;   // the replay graph file
   std::filesystem::path frames;  // the evaluation sink's JSON lines
   std::filesystem::path images;  // where it saves images: frames.images beside frames
+  std::filesystem::path record;  // the job's outcome and stage times (job_record.h)
 };
 
 struct JobOptions {

@@ -9,26 +9,26 @@
 #include <set>
 
 #include "comparison.h"
+#include "exit_codes.h"
 #include "framework/graph_session.h"
 #include "job_graph.h"
 #include "job_pool.h"
+#include "job_record.h"
+#include "merge.h"
 #include "options.h"
 #include "output_layout.h"
-#include "overlays.h"
 #include "progress_bar.h"
-#include "report_html.h"
-#include "report_numbers.h"
+#include "report_files.h"
+#include "shard_manifest.h"
 #include "stop_signals.h"
 #include "tilth/log.h"
+#include "tilth/version.h"
 
 namespace tilth::ab {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailed = 1;
-constexpr int kExitUsage = 2;
 // Frames in flight per graph: enough to keep the chain's parallel stages busy while
 // several graphs share the cores.
 constexpr std::size_t kMaxInFlight = 4;
@@ -76,49 +76,35 @@ JobResult job_result(const JobRun& run, const JobFiles& files, const std::string
   if (fs::exists(files.frames)) {
     result.frames = judge_frames(read_frame_records(files.frames), no_soil_below);
   }
+  if (fs::exists(files.images)) result.images = files.images;
   return result;
 }
 
-std::string column(const std::optional<double>& value, const char* format) {
-  if (!value) return "-";
-  char text[32];
-  std::snprintf(text, sizeof text, format, *value);
-  return text;
-}
-
-void print_summary(const Comparison& comparison, const OutputLayout& layout) {
-  std::printf("%-24s %7s %7s %7s %7s %12s %12s %7s\n", "variant", "frames", "valid", "missed",
-              "f.valid", "mean|err|mm", "max|err|mm", "IoU");
-  for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-    const Figures f = comparison.variant_figures(v);
-    const bool errors = f.error.count > 0;
-    std::printf("%-24s %7zu %7zu %7zu %7zu %12s %12s %7s\n", comparison.variants[v].name.c_str(),
-                f.frames, f.valid, f.missed, f.false_valid,
-                column(errors ? std::optional(f.error.mean_abs_mm) : std::nullopt, "%.3f").c_str(),
-                column(errors ? std::optional(f.error.max_abs_mm) : std::nullopt, "%.3f").c_str(),
-                column(f.mask ? f.mask->iou() : std::nullopt, "%.3f").c_str());
-  }
-  std::printf("report: %s\n", layout.report().c_str());
-}
-
-// The graphs of every (variant, recording) job, variant-major, or nothing when a graph has
-// problems (added to `problems`).
+// The graphs of the (variant, recording) jobs to run, variant-major: all, or a shard's.
+// Nothing when a graph has problems (added to `problems`).
 struct Jobs {
   std::vector<PreparedJob> graphs;
   std::vector<JobFiles> files;
   std::vector<std::string> labels;
+  std::vector<std::size_t> indices;  // in the whole comparison: v * recordings + r
 };
 
 Jobs prepare_jobs(const Options& options, const StageRegistry& registry, Diagnostics& problems) {
   Jobs jobs;
   for (std::size_t v = 0; v < options.variants.size(); ++v) {
     const Variant& variant = options.variants[v];
-    for (const auto& recording : options.recordings) {
+    for (std::size_t r = 0; r < options.recordings.size(); ++r) {
+      const Recording& recording = options.recordings[r];
+      const std::size_t index = v * options.recordings.size() + r;
+      if (options.shard && !options.shard->contains(index)) continue;
       const std::size_t before = problems.items().size();
       // Only the first variant saves the colour: the overlays show every mask over it.
       const JobOptions job_options{options.variables, kMaxInFlight, options.overlays > 0, v == 0};
       jobs.files.push_back(options.layout.job(variant.name, recording.name));
       jobs.labels.push_back(job_label(variant, recording));
+      jobs.indices.push_back(index);
+      // A shard run again replaces its own jobs' results, and only those.
+      fs::remove_all(jobs.files.back().graph.parent_path());
       auto graph =
           job_graph(variant, recording, jobs.files.back(), job_options, registry, problems);
       if (graph) jobs.graphs.push_back({std::move(*graph), recording.frames});
@@ -128,16 +114,29 @@ Jobs prepare_jobs(const Options& options, const StageRegistry& registry, Diagnos
   return jobs;
 }
 
-void write_outputs(const Comparison& comparison, const Options& options) {
-  Overlays overlays;
-  for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
-    overlays.push_back(disagreement_overlays(comparison, options.layout, r, options.overlays));
+// A shard leaves its jobs' results and its manifest, for `tilth ab merge`.
+int finish_shard(const Options& options, const Jobs& jobs, const std::vector<JobRun>& runs) {
+  ShardManifest manifest{{},
+                         *options.shard,
+                         std::string(version()),
+                         options.working_directory,
+                         options.arguments,
+                         comparison_identity(options),
+                         jobs.indices};
+  bool any_failed = false;
+  for (std::size_t j = 0; j < runs.size(); ++j) {
+    const JobResult result =
+        job_result(runs[j], jobs.files[j], jobs.labels[j], options.no_soil_below);
+    write_job_record(jobs.files[j], result);
+    if (result.failed) std::cerr << "tilth ab: a graph failed: " << result.failure << "\n";
+    any_failed = any_failed || result.failed;
   }
-  const auto summary = summary_json(comparison, overlays);
-  write_text(options.layout.summary_json(), summary.dump(2) + "\n");
-  write_summary_csv(comparison, options.layout.summary_csv());
-  write_frames_csv(comparison, options.layout.frames_csv());
-  write_text(options.layout.report(), report_html(comparison, summary, overlays));
+  write_shard_manifest(options.layout, manifest);
+  if (!options.quiet) {
+    std::printf("shard %s: %zu of the comparison's jobs in %s; 'tilth ab merge' makes the report\n",
+                options.shard->text().c_str(), runs.size(), options.layout.dir.c_str());
+  }
+  return any_failed ? kExitFailed : kExitOk;
 }
 
 int run(Options options) {
@@ -158,7 +157,11 @@ int run(Options options) {
     return kExitUsage;
   }
   try {
-    prepare_output(options.layout, options.overwrite);
+    if (options.shard) {
+      prepare_shard_output(options.layout, *options.shard);
+    } else {
+      prepare_output(options.layout, options.overwrite);
+    }
   } catch (const Error& error) {
     std::cerr << "tilth ab: --out " << error.what() << "\n";
     return kExitUsage;
@@ -185,12 +188,13 @@ int run(Options options) {
     std::cerr << "tilth ab: interrupted; no report written\n";
     return kExitFailed;
   }
+  if (options.shard) return finish_shard(options, jobs, runs);
   Comparison comparison{options.variants, options.recordings, {}, options.no_soil_below};
   for (std::size_t j = 0; j < runs.size(); ++j) {
     comparison.jobs.push_back(
         job_result(runs[j], jobs.files[j], jobs.labels[j], options.no_soil_below));
   }
-  write_outputs(comparison, options);
+  write_report(comparison, options.layout, options.overlays);
   if (!options.keep_images) {
     for (const auto& files : jobs.files) fs::remove_all(files.images);
   }
@@ -207,6 +211,7 @@ int run(Options options) {
 int main(int argc, char** argv) {
   using namespace tilth::ab;
   tilth::tools::install_stop_handlers("ab");
+  if (argc > 1 && std::string_view(argv[1]) == "merge") return merge_command(argc, argv);
   Options options;
   try {
     options = parse_options(argc, argv);

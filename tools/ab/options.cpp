@@ -14,6 +14,7 @@ namespace fs = std::filesystem;
 const char* const kUsage =
     R"(usage: tilth ab RECORDING... (--variant NAME[:SETTING] | --variants FILE)...
                 [--out DIR] [options]
+       tilth ab merge SHARD_DIR... --out DIR [--overwrite] [--quiet]
 
 Replays each recording through each variant of the measurement chain (one graph per
 variant and recording, several at once, as fast as they go) and compares the variants
@@ -22,6 +23,10 @@ IoU / precision / recall, time per stage. Writes DIR/report.html (self-contained
 summary.json, summary.csv and frames.csv. docs/ab-testing.md explains every figure.
 SIGINT or SIGTERM stops the graphs cleanly and writes no report (exit code 1); a second
 signal exits at once (code 130).
+
+'tilth ab merge' writes that report from the results that shards (--shard) left in each
+SHARD_DIR, the same as one run would have written apart from timings, and lists the
+jobs that no shard finished (exit code 1).
 
   RECORDING                 an image-folder recording (a folder with recording.json),
                             an .mcap file, or a folder holding several of them
@@ -42,6 +47,10 @@ signal exits at once (code 130).
   --no-soil-below F         a frame whose truth mask is less than F soil has no visible
                             soil and must be reported invalid (default 0.01)
   --keep-images             keep every frame's saved masks and colour (DIR/runs/)
+  --shard I/N               run only shard I of N of the (variant, recording) jobs
+                            (job j is in shard j mod N) and leave their results in DIR
+                            beside other shards'; no report: 'tilth ab merge' writes it
+                            from every shard's DIR (docs/fleet.md)
   --quiet                   no progress bar and no summary
   --verbose                 debug log lines
 )";
@@ -66,7 +75,7 @@ fs::path default_chain(const cli::CommandLine& line) {
 Options parse_options(int argc, char** argv) {
   const cli::CommandLine line(argc, argv, 1,
                               {"--variant", "--variants", "--chain", "--var", "--out", "--jobs",
-                               "--overlays", "--no-soil-below"},
+                               "--overlays", "--no-soil-below", "--shard"},
                               {"--help", "--overwrite", "--keep-images", "--quiet", "--verbose"});
   Options options;
   options.help = line.flag("--help");
@@ -96,6 +105,15 @@ Options parse_options(int argc, char** argv) {
     throw UsageError(error.what());
   }
   options.keep_images = line.flag("--keep-images");
+  if (const auto shard = line.value("--shard")) {
+    try {
+      options.shard = parse_shard(*shard);
+    } catch (const Error& error) {
+      throw UsageError(error.what());
+    }
+  }
+  options.arguments.assign(argv + 1, argv + argc);
+  options.working_directory = fs::current_path();
   options.quiet = line.flag("--quiet");
   return options;
 }

@@ -2,12 +2,15 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "framework/graph_loader.h"
 #include "output_layout.h"
 #include "recording_list.h"
+#include "shard.h"
 #include "tilth/error.h"
 #include "variant.h"
 
@@ -25,6 +28,9 @@ struct Options {
   std::size_t overlays = 3;
   double no_soil_below = 0.01;
   bool keep_images = false;
+  std::optional<Shard> shard;               // run only these jobs, leave their results for a merge
+  std::vector<std::string> arguments;       // as given, for a shard's manifest
+  std::filesystem::path working_directory;  // where they were given
   bool quiet = false;
   bool verbose = false;
   bool help = false;

@@ -28,4 +28,19 @@ void prepare_output(const OutputLayout& layout, bool overwrite) {
   if (error) throw Error(layout.dir.string() + ": cannot create the folder: " + error.message());
 }
 
+void prepare_shard_output(const OutputLayout& layout, const Shard& shard) {
+  std::error_code error;
+  if (fs::exists(layout.dir, error) && !fs::is_empty(layout.dir, error) &&
+      !fs::is_directory(layout.shards(), error) && !fs::is_directory(layout.runs(), error)) {
+    throw Error(layout.dir.string() +
+                ": folder exists and holds no shard results (runs/, shards/); not writing a "
+                "shard's results into it");
+  }
+  fs::create_directories(layout.dir, error);
+  if (error) throw Error(layout.dir.string() + ": cannot create the folder: " + error.message());
+  const fs::path manifest = layout.shard_manifest(shard);
+  fs::remove(manifest, error);
+  if (error) throw Error(manifest.string() + ": cannot remove: " + error.message());
+}
+
 }  // namespace tilth::ab

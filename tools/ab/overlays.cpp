@@ -137,11 +137,10 @@ std::vector<Disagreement> ranked_disagreements(const Comparison& comparison,
   return ranked;
 }
 
-OverlayFrame overlay_frame(const Comparison& comparison, const OutputLayout& layout,
-                           std::size_t recording, const Disagreement& disagreement) {
-  const std::string recording_name = comparison.recordings[recording].name;
+OverlayFrame overlay_frame(const Comparison& comparison, std::size_t recording,
+                           const Disagreement& disagreement) {
   const auto images = [&](std::size_t variant) {
-    return layout.job(comparison.variants[variant].name, recording_name).images;
+    return comparison.job(variant, recording).images;
   };
   const std::uint64_t id = disagreement.frame_id;
   OverlayFrame frame{id, describe(disagreement), {}};
@@ -184,13 +183,12 @@ OverlayFrame overlay_frame(const Comparison& comparison, const OutputLayout& lay
 
 }  // namespace
 
-std::vector<OverlayFrame> disagreement_overlays(const Comparison& comparison,
-                                                const OutputLayout& layout, std::size_t recording,
+std::vector<OverlayFrame> disagreement_overlays(const Comparison& comparison, std::size_t recording,
                                                 std::size_t count) {
   std::vector<OverlayFrame> frames;
   const auto ranked = ranked_disagreements(comparison, recording);
   for (std::size_t i = 0; i < std::min(count, ranked.size()); ++i) {
-    frames.push_back(overlay_frame(comparison, layout, recording, ranked[i]));
+    frames.push_back(overlay_frame(comparison, recording, ranked[i]));
   }
   return frames;
 }

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "comparison.h"
-#include "output_layout.h"
 
 namespace tilth::ab {
 
@@ -25,9 +24,8 @@ struct OverlayFrame {
 
 // Frames ranked by: validity differs between variants, then the spread of the valid
 // distances, then the largest |error|; ties go to the earlier frame. Reads the images
-// the evaluation sinks saved.
-std::vector<OverlayFrame> disagreement_overlays(const Comparison& comparison,
-                                                const OutputLayout& layout, std::size_t recording,
+// the evaluation sinks saved (JobResult::images).
+std::vector<OverlayFrame> disagreement_overlays(const Comparison& comparison, std::size_t recording,
                                                 std::size_t count);
 
 }  // namespace tilth::ab

@@ -50,20 +50,6 @@ json figures_json(const Figures& figures) {
           {"mask", mask}};
 }
 
-json stage_times_json(const std::vector<StageTime>& stages) {
-  json list = json::array();
-  for (const auto& stage : stages) {
-    list.push_back({{"node", stage.node},
-                    {"type", stage.type},
-                    {"frames", stage.latency.count},
-                    {"mean_ms", stage.latency.mean_ms},
-                    {"p50_ms", stage.latency.p50_ms},
-                    {"p99_ms", stage.latency.p99_ms},
-                    {"max_ms", stage.latency.max_ms}});
-  }
-  return list;
-}
-
 std::string setting_text(const NodeSetting& setting) {
   return setting.node + "." + setting.param + "=" +
          (setting.command_line_text ? *setting.command_line_text : setting.value.dump());
@@ -137,23 +123,47 @@ std::string summary_row(const std::string& variant, const std::string& recording
 
 }  // namespace
 
-json summary_json(const Comparison& comparison, const Overlays& overlays) {
-  json variants = json::array();
-  for (const auto& variant : comparison.variants) {
+json stage_times_json(const std::vector<StageTime>& stages) {
+  json list = json::array();
+  for (const auto& stage : stages) {
+    list.push_back({{"node", stage.node},
+                    {"type", stage.type},
+                    {"frames", stage.latency.count},
+                    {"mean_ms", stage.latency.mean_ms},
+                    {"p50_ms", stage.latency.p50_ms},
+                    {"p99_ms", stage.latency.p99_ms},
+                    {"max_ms", stage.latency.max_ms}});
+  }
+  return list;
+}
+
+json variants_json(const std::vector<Variant>& variants) {
+  json list = json::array();
+  for (const auto& variant : variants) {
     json settings = json::array();
     for (const auto& setting : variant.settings) settings.push_back(setting_text(setting));
-    variants.push_back({{"name", variant.name},
-                        {"description", variant.description},
-                        {"chain", variant.chain.string()},
-                        {"settings", settings}});
+    list.push_back({{"name", variant.name},
+                    {"description", variant.description},
+                    {"chain", variant.chain.string()},
+                    {"settings", settings}});
   }
-  json recordings = json::array();
-  for (const auto& recording : comparison.recordings) {
-    recordings.push_back(
+  return list;
+}
+
+json recordings_json(const std::vector<Recording>& recordings) {
+  json list = json::array();
+  for (const auto& recording : recordings) {
+    list.push_back(
         {{"name", recording.name},
          {"path", recording.path.string()},
          {"format", recording.format == RecordingFormat::kMcap ? "mcap" : "image_folder"}});
   }
+  return list;
+}
+
+json summary_json(const Comparison& comparison, const Overlays& overlays) {
+  const json variants = variants_json(comparison.variants);
+  const json recordings = recordings_json(comparison.recordings);
   json by_variant = json::array();
   json by_recording = json::array();
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {

@@ -19,6 +19,11 @@ using Overlays = std::vector<std::vector<OverlayFrame>>;
 
 nlohmann::ordered_json summary_json(const Comparison& comparison, const Overlays& overlays);
 
+// Parts of summary.json, also written by a shard (shard_manifest.h, job_record.h).
+nlohmann::ordered_json stage_times_json(const std::vector<StageTime>& stages);
+nlohmann::ordered_json variants_json(const std::vector<Variant>& variants);
+nlohmann::ordered_json recordings_json(const std::vector<Recording>& recordings);
+
 // Throw tilth::Error naming the file when it cannot be written.
 void write_summary_csv(const Comparison& comparison, const std::filesystem::path& file);
 void write_frames_csv(const Comparison& comparison, const std::filesystem::path& file);

@@ -1,0 +1,50 @@
+#include "report_files.h"
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "overlays.h"
+#include "report_html.h"
+#include "report_numbers.h"
+
+namespace tilth::ab {
+namespace {
+
+std::string column(const std::optional<double>& value, const char* format) {
+  if (!value) return "-";
+  char text[32];
+  std::snprintf(text, sizeof text, format, *value);
+  return text;
+}
+
+}  // namespace
+
+void write_report(const Comparison& comparison, const OutputLayout& layout, std::size_t overlays) {
+  Overlays shown;
+  for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
+    shown.push_back(disagreement_overlays(comparison, r, overlays));
+  }
+  const auto summary = summary_json(comparison, shown);
+  write_text(layout.summary_json(), summary.dump(2) + "\n");
+  write_summary_csv(comparison, layout.summary_csv());
+  write_frames_csv(comparison, layout.frames_csv());
+  write_text(layout.report(), report_html(comparison, summary, shown));
+}
+
+void print_summary(const Comparison& comparison, const OutputLayout& layout) {
+  std::printf("%-24s %7s %7s %7s %7s %12s %12s %7s\n", "variant", "frames", "valid", "missed",
+              "f.valid", "mean|err|mm", "max|err|mm", "IoU");
+  for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
+    const Figures f = comparison.variant_figures(v);
+    const bool errors = f.error.count > 0;
+    std::printf("%-24s %7zu %7zu %7zu %7zu %12s %12s %7s\n", comparison.variants[v].name.c_str(),
+                f.frames, f.valid, f.missed, f.false_valid,
+                column(errors ? std::optional(f.error.mean_abs_mm) : std::nullopt, "%.3f").c_str(),
+                column(errors ? std::optional(f.error.max_abs_mm) : std::nullopt, "%.3f").c_str(),
+                column(f.mask ? f.mask->iou() : std::nullopt, "%.3f").c_str());
+  }
+  std::printf("report: %s\n", layout.report().c_str());
+}
+
+}  // namespace tilth::ab
