@@ -20,7 +20,6 @@ import json
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -29,10 +28,9 @@ SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "support"))
 from fake_gige_camera import FakeCamera  # noqa: E402
 from ports import free_port  # noqa: E402
-from processes import interrupt  # noqa: E402
+from processes import interrupt, start_logged  # noqa: E402
 from pymodbus_tcp import ModbusTcpClient  # noqa: E402
 
-MAX_LOG_BYTES = 5_000_000
 POLL_S = 0.001  # a master polling as fast as it can would take a core from the graph
 MODES = {
     "free_running": {},
@@ -86,11 +84,9 @@ def run_mode(args, mode, work):
     try:
         depth.start()
         color.start()
-        with open(log_path, "w") as log:
-            tilth = subprocess.Popen(
-                ["prlimit", "--fsize=%d" % MAX_LOG_BYTES, args.tilth, "run", graph, "--quiet",
-                 "--var", "depth_camera=" + depth.address, "--var", "color_camera=" + color.address],
-                stdout=log, stderr=log)
+        tilth = start_logged([args.tilth, "run", graph, "--quiet",
+                              "--var", "depth_camera=" + depth.address,
+                              "--var", "color_camera=" + color.address], log_path)
         time.sleep(3)  # the cameras open; the capture clocks settle
         if tilth.poll() is not None:
             raise RuntimeError("tilth stopped; its log: " + open(log_path).read()[-3000:])

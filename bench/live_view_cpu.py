@@ -18,7 +18,6 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import threading
@@ -29,10 +28,9 @@ SOURCE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "support"))
 from fake_gige_camera import FakeCamera  # noqa: E402
 from ports import free_port  # noqa: E402
-from processes import interrupt  # noqa: E402
+from processes import interrupt, start_logged  # noqa: E402
 
 TICKS = os.sysconf("SC_CLK_TCK")
-MAX_LOG_BYTES = 5_000_000
 
 
 def view_thread_seconds(pid):
@@ -133,11 +131,9 @@ def main():
     try:
         depth.start()
         color.start()
-        with open(log_path, "w") as log:
-            tilth = subprocess.Popen(
-                ["prlimit", "--fsize=%d" % MAX_LOG_BYTES, args.tilth, "run", graph, "--quiet",
-                 "--var", "depth_camera=" + depth.address, "--var", "color_camera=" + color.address],
-                stdout=log, stderr=log)
+        tilth = start_logged([args.tilth, "run", graph, "--quiet",
+                              "--var", "depth_camera=" + depth.address,
+                              "--var", "color_camera=" + color.address], log_path)
         deadline = time.monotonic() + 60
         while True:
             try:

@@ -36,11 +36,15 @@ JobResult read_job_record(const JobFiles& files, double no_soil_below) {
   } catch (const json::exception& error) {
     throw Error(origin + ": not a job record of tilth ab: " + error.what());
   }
+  read_job_frames(files, no_soil_below, result);
+  return result;
+}
+
+void read_job_frames(const JobFiles& files, double no_soil_below, JobResult& result) {
   if (fs::exists(files.frames)) {
     result.frames = judge_frames(read_frame_records(files.frames), no_soil_below);
   }
   if (fs::exists(files.images)) result.images = files.images;
-  return result;
 }
 
 }  // namespace tilth::ab

@@ -12,8 +12,12 @@ namespace tilth::ab {
 void write_job_record(const JobFiles& files, const JobResult& result);
 
 // The job's result from files.record and its frames (files.frames), judged with
-// `no_soil_below`, its images at files.images. Throws tilth::Error naming a file that is
-// missing or malformed.
+// `no_soil_below`, its images at files.images (read_job_frames). Throws tilth::Error naming a file
+// that is missing or malformed.
 JobResult read_job_record(const JobFiles& files, double no_soil_below);
+
+// The job's frames (files.frames, when the sink wrote them), judged with
+// `no_soil_below`, and its images (files.images, when saved), into `result`.
+void read_job_frames(const JobFiles& files, double no_soil_below, JobResult& result);
 
 }  // namespace tilth::ab

@@ -73,10 +73,7 @@ JobResult job_result(const JobRun& run, const JobFiles& files, const std::string
       result.stages.push_back({stage.node.substr(prefix.size()), stage.type, stage.latency});
     }
   }
-  if (fs::exists(files.frames)) {
-    result.frames = judge_frames(read_frame_records(files.frames), no_soil_below);
-  }
-  if (fs::exists(files.images)) result.images = files.images;
+  read_job_frames(files, no_soil_below, result);
   return result;
 }
 
