@@ -4,8 +4,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "frames_csv.h"
 #include "fuzz_input_file.h"
+#include "image_folder/frames_csv.h"
 #include "tilth/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

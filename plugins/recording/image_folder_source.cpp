@@ -16,16 +16,16 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "frames_csv.h"
-#include "host_timestamps_csv.h"
-#include "pixel_checks.h"
-#include "recording_json.h"
+#include "image_folder/frames_csv.h"
+#include "image_folder/host_timestamps_csv.h"
+#include "image_folder/image_file.h"
+#include "image_folder/pixel_checks.h"
+#include "image_folder/recording_json.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
-#include "tilth/regular_file.h"
 #include "tilth/replay_host_time.h"
 
 namespace tilth::recording {
@@ -36,9 +36,6 @@ namespace fs = std::filesystem;
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
-// A PNG of the largest image a rig gives (16-bit 1280x1024x3: 7.5 MiB raw) with room
-// for PNG's worst case; a larger file is not a frame of a recording.
-constexpr std::uint64_t kMaxImageBytes = 256 << 20;
 
 // Each frame's host capture time from host_timestamps.csv; none without the file.
 std::vector<std::int64_t> recorded_host_timestamps(const fs::path& folder,
@@ -173,22 +170,12 @@ class ImageFolderSource final : public Source {
         file.string() + " (frames.csv line " + std::to_string(entry.line) + ")";
     cv::Mat image;
     std::string problem;
-    if (!fs::exists(file)) {
-      problem = "no such file";
-    } else {
-      try {
-        const std::string bytes = read_regular_file(file, kMaxImageBytes, "PNG image");
-        if (!bytes.empty()) {
-          image = cv::imdecode(
-              cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
-              cv::IMREAD_UNCHANGED);
-        }
-        if (image.empty()) problem = "not a readable image";
-      } catch (const Error& error) {
-        const std::string prefix = file.string() + ": ";
-        const std::string text = error.what();
-        problem = text.starts_with(prefix) ? text.substr(prefix.size()) : text;
-      }
+    try {
+      image = read_image_file(file);
+    } catch (const Error& error) {
+      const std::string prefix = file.string() + ": ";
+      const std::string text = error.what();
+      problem = text.starts_with(prefix) ? text.substr(prefix.size()) : text;
     }
     if (!problem.empty()) {
       if (stop_on_missing_) throw Error(where + ": " + problem + " (on_missing: stop)");

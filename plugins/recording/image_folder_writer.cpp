@@ -6,17 +6,15 @@
 // valid recording that lacks at most the frame being written.
 #include <array>
 #include <fstream>
-#include <iomanip>
 #include <optional>
-#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "frames_csv.h"
-#include "host_timestamps_csv.h"
-#include "pixel_checks.h"
-#include "recording_json.h"
+#include "image_folder/frames_csv.h"
+#include "image_folder/host_timestamps_csv.h"
+#include "image_folder/pixel_checks.h"
+#include "image_folder/recording_json.h"
 #include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
@@ -36,13 +34,6 @@ constexpr std::string_view kCalibrationFile = "rig.calib.json";
 constexpr std::array<std::string_view, 7> kRecordingEntries{
     "recording.json", "frames.csv", kHostTimestampsFile, kCalibrationFile, "depth",
     "color",          "mask"};
-
-// The frame's file name: its index, six digits or more.
-std::string file_name(std::uint64_t index) {
-  std::ostringstream name;
-  name << std::setw(6) << std::setfill('0') << index << ".png";
-  return name.str();
-}
 
 // Throws unless the folder can be written: it does not exist, is empty, or holds a
 // recording that `overwrite` allows to replace. Changes nothing, so a graph that fails to
@@ -116,10 +107,10 @@ class ImageFolderWriter final : public Sink {
     entry.index = frame.info().frame_id;
     entry.depth_timestamp_ns = raw.device_timestamp_ns;
     entry.color_timestamp_ns = color.device_timestamp_ns;
-    entry.depth = "depth/" + file_name(entry.index);
-    entry.color = "color/" + file_name(entry.index);
+    entry.depth = "depth/" + frame_file_name(entry.index);
+    entry.color = "color/" + frame_file_name(entry.index);
     if (truth != nullptr && !truth->residue_mask.empty()) {
-      entry.mask = "mask/" + file_name(entry.index);
+      entry.mask = "mask/" + frame_file_name(entry.index);
     }
     if (truth != nullptr) entry.ground_truth_mm = truth->distance_mm;
     const std::int64_t host_time = recorded_host_time(frame.info(), entry.depth_timestamp_ns);

@@ -1,5 +1,6 @@
 """Starting a process the tests or benchmarks run with its output bounded, and stopping it
 by its pid."""
+import os
 import signal
 import subprocess
 
@@ -25,3 +26,25 @@ def interrupt(process, seconds=30):
     except subprocess.TimeoutExpired:
         process.kill()
         process.wait()
+
+
+def run_bounded(command, folder, seconds=120):
+    """Runs `command` to its end with its standard output and error in files of `folder`
+    (each at most MAX_LOG_BYTES), killed by its pid after `seconds`; returns a
+    subprocess.CompletedProcess with both outputs as text."""
+    paths = [os.path.join(folder, "run-%d.%s" % (os.getpid(), name)) for name in ("out", "err")]
+    with open(paths[0], "w") as out, open(paths[1], "w") as err:
+        process = subprocess.Popen(["prlimit", "--fsize=%d" % MAX_LOG_BYTES, *command],
+                                   stdout=out, stderr=err)
+        try:
+            process.wait(seconds)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+            raise
+    texts = []
+    for path in paths:
+        with open(path) as f:
+            texts.append(f.read())
+        os.remove(path)
+    return subprocess.CompletedProcess(command, process.returncode, texts[0], texts[1])

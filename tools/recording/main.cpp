@@ -1,12 +1,16 @@
 // `tilth recording` (the tilth-recording program): look into, repair and convert
-// recordings. MCAP files are read with the mcap plugin's format library; conversions run
-// the recording stages in process (conversion.h).
+// recordings, and import masks from labelling tools into them. MCAP files are read with
+// the mcap plugin's format library; conversions run the recording stages in process
+// (conversion.h); masks are carried onto the depth grid by the registration stage
+// (mask_import.h).
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "command_line.h"
 #include "commands.h"
@@ -14,6 +18,7 @@
 #include "data_loss_report.h"
 #include "framework/diagnostics.h"
 #include "framework/nearest_names.h"
+#include "mask_import.h"
 #include "mcap/mcap_recording.h"
 #include "output_path.h"
 #include "stop_signals.h"
@@ -36,9 +41,26 @@ constexpr const char* kUsage = R"(usage: tilth recording COMMAND ARGS
         [--overwrite]       (replace the recording in DIR)
   import DIR FILE           an image-folder recording to an MCAP recording
         [--compression zstd|lz4|none] [--overwrite]
+  import-masks DIR LABELS   masks drawn in a labelling tool into the image-folder
+        --residue NAMES     recording DIR (mask/NNNNNN.png, the mask column of
+        --soil NAMES        frames.csv); LABELS is the tool's export (below)
+        [--grid color|depth] [--overwrite]
 
---overwrite replaces only a recording (an MCAP file, a folder with recording.json),
-and no output may be, hold or lie inside its input.
+For repair, export and import, --overwrite replaces only a recording (an MCAP file, a
+folder with recording.json), and no output may be, hold or lie inside its input.
+
+import-masks: LABELS holds CVAT's labelmap.txt and SegmentationClass/*.png (export
+format "Segmentation mask 1.1"), or LabelMe's label_names.txt (or class_names.txt)
+and PNGs of class indices, palette or grey, in it or in SegmentationClassPNG/
+(labelme2voc; index 255 is unknown). A mask belongs to the frame whose colour
+image has its file name (000012.png: color/000012.png); a mask that matches no frame
+is an error. --residue and --soil list the labels (comma-separated) that are residue
+(255) and soil (0); any other label is unknown (128), and a colour or index that no
+label has is an error. --grid color (the default): masks drawn on the colour images,
+carried onto the depth grid through the recording's calibration (128 where a depth
+pixel has no depth or the colour camera does not see it); depth: drawn on the depth
+images. --overwrite replaces the frames' existing masks; frames.csv is replaced whole
+(a new file renamed over it). An MCAP recording: `export` it to a folder first.
 
 SIGINT or SIGTERM stops export and import cleanly: the frames converted so far are
 written and the output closed (an MCAP file with its summary), exit code 0; it stops a
@@ -128,13 +150,95 @@ int convert(const CommandLine& line) {
   return result.data_lost.empty() ? kExitOk : kExitDataLost;
 }
 
+// "a,b" "c" -> a, b, c
+std::vector<std::string> label_names(const CommandLine& line, const std::string& option) {
+  std::vector<std::string> names;
+  for (const std::string& value : line.values(option)) {
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t comma = value.find(',', start);
+      const std::string name = value.substr(start, comma - start);
+      if (name.empty()) {
+        throw tilth::Error(option + " '" + value + "': expected label names separated by commas");
+      }
+      names.push_back(name);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  return names;
+}
+
+// "0-4, 7, 9"
+std::string index_ranges(const std::vector<std::uint64_t>& indices) {
+  std::string text;
+  for (std::size_t i = 0; i < indices.size();) {
+    std::size_t last = i;
+    while (last + 1 < indices.size() && indices[last + 1] == indices[last] + 1) ++last;
+    text += (text.empty() ? "" : ", ") + std::to_string(indices[i]) +
+            (last > i ? "-" + std::to_string(indices[last]) : "");
+    i = last + 1;
+  }
+  return text;
+}
+
+int import_masks(const CommandLine& line) {
+  const auto& args = line.positional();
+  if (args.size() != 3 || line.value("--compression")) {
+    return usage_error(
+        "import-masks takes DIR LABELS --residue NAMES --soil NAMES [--grid "
+        "color|depth] [--overwrite]");
+  }
+  tilth::tools::MaskImportOptions options;
+  options.recording = args[1];
+  options.labels = args[2];
+  try {
+    options.residue = label_names(line, "--residue");
+    options.soil = label_names(line, "--soil");
+  } catch (const tilth::Error& error) {
+    return usage_error(error.what());
+  }
+  if (options.residue.empty() && options.soil.empty()) {
+    return usage_error(
+        "import-masks: say which labels are residue and which soil (--residue "
+        "NAMES, --soil NAMES); every other label is unknown");
+  }
+  const std::string grid = line.value("--grid").value_or("color");
+  if (grid != "color" && grid != "depth") {
+    return usage_error("--grid: expected color or depth, got '" + grid + "'");
+  }
+  options.depth_grid = grid == "depth";
+  options.overwrite = line.flag("--overwrite");
+  const auto result = tilth::tools::import_masks(options);
+  const double pixels = static_cast<double>(result.residue + result.soil + result.unknown);
+  const auto percent = [&](std::uint64_t count) {
+    return std::to_string(static_cast<int>(100.0 * static_cast<double>(count) / pixels + 0.5)) +
+           " %";
+  };
+  std::cout << options.recording.string() << ": " << result.imported << " masks from "
+            << result.masks.string() << " (" << grid << " grid): residue "
+            << percent(result.residue) << ", soil " << percent(result.soil) << ", unknown "
+            << percent(result.unknown) << " of their pixels\n";
+  if (!result.without_mask.empty()) {
+    std::cout << result.without_mask.size() << " frames got no mask (index "
+              << index_ranges(result.without_mask) << "); their mask column is as it was\n";
+  }
+  return kExitOk;
+}
+
+bool has_mask_options(const CommandLine& line) {
+  return line.value("--grid") || !line.values("--residue").empty() ||
+         !line.values("--soil").empty();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   tilth::tools::install_stop_handlers("tilth recording");
   std::optional<CommandLine> parsed;
   try {
-    parsed.emplace(argc, argv, 1, std::set<std::string>{"--compression"},
+    parsed.emplace(argc, argv, 1,
+                   std::set<std::string>{"--compression", "--residue", "--soil", "--grid"},
                    std::set<std::string>{"--overwrite", "--help"});
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
@@ -147,11 +251,16 @@ int main(int argc, char** argv) {
     }
     if (line.positional().empty()) return usage_error("expected a command");
     const std::string& command = line.positional()[0];
+    if (command == "import-masks") return import_masks(line);
+    if (has_mask_options(line)) {
+      return usage_error("--residue, --soil and --grid are import-masks options");
+    }
     if (command == "info") return info(line);
     if (command == "repair") return repair(line);
     if (command == "export" || command == "import") return convert(line);
-    return usage_error("unknown command '" + command + "'" +
-                       tilth::did_you_mean(command, {"info", "repair", "export", "import"}));
+    return usage_error(
+        "unknown command '" + command + "'" +
+        tilth::did_you_mean(command, {"info", "repair", "export", "import", "import-masks"}));
   } catch (const tilth::GraphError& error) {
     std::cerr << error.what() << "\n";
     return kExitUsage;

@@ -3,36 +3,14 @@
 #include <algorithm>
 #include <vector>
 
+#include "stage_in_process.h"
 #include "tilth/error.h"
 
 namespace tilth::train_segmenter {
 namespace {
 
-// A stage made as the graph loader would make it: every parameter checked, defaults for
-// the ones not given.
-StageInstance make_stage(const StageRegistry& registry, const std::string& type,
-                         const nlohmann::json& given) {
-  const StageRegistry::Entry* entry = registry.find(type);
-  if (entry == nullptr) {
-    throw Error("stage type '" + type + "' is not provided by any loaded plugin");
-  }
-  nlohmann::json values = nlohmann::json::object();
-  for (const ParamSpec& spec : entry->descriptor.params) values[spec.name] = spec.default_value;
-  for (const auto& [name, value] : given.items()) {
-    const ParamSpec* spec = entry->descriptor.param(name);
-    if (spec == nullptr) throw Error(type + ": no parameter '" + name + "'");
-    if (const std::string expected = spec->check(value); !expected.empty()) {
-      throw Error(type + ": parameter '" + name + "': expected " + expected + ", got " +
-                  value.dump());
-    }
-    values[name] = value;
-  }
-  StageContext context;
-  context.node = type;
-  context.params = Params(std::move(values));
-  context.log = Logger(type);
-  return registry.create(type, context);
-}
+using tools::make_stage;
+using tools::stage_as;
 
 std::size_t port_index(const std::vector<PortSpec>& ports, const std::string& name,
                        const std::string& type) {
@@ -40,13 +18,6 @@ std::size_t port_index(const std::vector<PortSpec>& ports, const std::string& na
     if (ports[i].name == name) return i;
   }
   throw Error(type + " has no port '" + name + "'");
-}
-
-template <class T>
-T& stage_as(StageInstance& instance, const std::string& type) {
-  auto* stage = dynamic_cast<T*>(instance.stage.get());
-  if (stage == nullptr) throw Error(type + " is not the kind of stage expected here");
-  return *stage;
 }
 
 }  // namespace

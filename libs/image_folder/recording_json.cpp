@@ -1,4 +1,4 @@
-#include "recording_json.h"
+#include "image_folder/recording_json.h"
 
 #include <array>
 #include <fstream>

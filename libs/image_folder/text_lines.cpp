@@ -1,4 +1,4 @@
-#include "text_lines.h"
+#include "image_folder/text_lines.h"
 
 #include <algorithm>
 

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "frames_csv.h"
+#include "image_folder/frames_csv.h"
 
 namespace tilth::recording {
 

@@ -1,13 +1,17 @@
-#include "frames_csv.h"
+#include "image_folder/frames_csv.h"
 
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <fstream>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <string_view>
 
-#include "text_lines.h"
+#include "image_folder/text_lines.h"
 #include "tilth/error.h"
+#include "tilth/regular_file.h"
 
 namespace tilth::recording {
 namespace {
@@ -200,6 +204,68 @@ std::string frames_csv_line(const FrameEntry& entry) {
   return std::to_string(entry.index) + "," + std::to_string(entry.depth_timestamp_ns) + "," +
          std::to_string(entry.color_timestamp_ns) + "," + entry.depth + "," + entry.color + "," +
          entry.mask + "," + ground_truth;
+}
+
+std::string frame_file_name(std::uint64_t index) {
+  std::ostringstream name;
+  name << std::setw(6) << std::setfill('0') << index << ".png";
+  return name.str();
+}
+
+void rewrite_mask_column(const fs::path& file, const std::map<std::size_t, std::string>& masks) {
+  const std::string text = read_regular_file(file, kMaxFramesCsvBytes, "frames.csv");
+  std::string rewritten;
+  rewritten.reserve(text.size() + 32 * masks.size());
+  std::optional<std::size_t> mask_position;  // none: the column is added at the end
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < text.size();) {
+    const std::size_t newline = text.find('\n', start);
+    const std::size_t next = newline == std::string::npos ? text.size() : newline + 1;
+    std::string_view line = std::string_view(text).substr(start, next - start);
+    start = next;
+    ++number;
+    // The line's end ("\n", "\r\n" or nothing) is kept as it was.
+    std::string_view end = line;
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
+    end.remove_prefix(line.size());
+    const auto fields = split(line);
+    if (number == 1) {
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        if (fields[i] == kColumnNames[kMask]) mask_position = i;
+      }
+      rewritten.append(line).append(mask_position ? "" : ",mask").append(end);
+      continue;
+    }
+    const auto mask = masks.find(number);
+    if (line.empty() || (mask == masks.end() && mask_position)) {
+      rewritten.append(line).append(end);
+      continue;
+    }
+    const std::string value = mask == masks.end() ? "" : mask->second;
+    if (!mask_position) {
+      rewritten.append(line).append(",").append(value).append(end);
+      continue;
+    }
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      rewritten.append(i == 0 ? "" : ",").append(i == *mask_position ? value : fields[i]);
+    }
+    rewritten.append(end);
+  }
+  fs::path temporary = file;
+  temporary += ".new";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << rewritten;
+    out.close();
+    if (!out) throw Error(temporary.string() + ": cannot write");
+  }
+  std::error_code error;
+  fs::rename(temporary, file, error);
+  if (error) {
+    fs::remove(temporary);
+    throw Error(file.string() + ": cannot replace with " + temporary.string() + ": " +
+                error.message());
+  }
 }
 
 }  // namespace tilth::recording

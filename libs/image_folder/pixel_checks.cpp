@@ -1,4 +1,4 @@
-#include "pixel_checks.h"
+#include "image_folder/pixel_checks.h"
 
 namespace tilth::recording {
 

@@ -1,10 +1,11 @@
 // frames.csv of an image-folder recording: the whole index read and checked at once,
-// and the lines the writer appends.
+// the lines the writer appends, and the mask column rewritten when masks are imported.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -42,5 +43,18 @@ std::vector<FrameEntry> read_frames_csv(const std::filesystem::path& file);
 
 // One line of frames.csv, without the newline, in kFramesCsvHeader's column order.
 std::string frames_csv_line(const FrameEntry& entry);
+
+// A frame's file name in depth/, color/ and mask/: its index, six digits or more
+// ("000012.png").
+std::string frame_file_name(std::uint64_t index);
+
+// Replaces the `mask` field of the lines of `file` (a frames.csv read_frames_csv has
+// accepted) that `masks` names by line number (FrameEntry::line), adding the column at
+// the end of every line when the file has none; every other byte stays as it was. Writes
+// FILE.new beside it and renames it over `file`, so a reader sees the old index or the
+// new one, never a mix. Throws tilth::Error naming the file when it cannot be read or
+// written.
+void rewrite_mask_column(const std::filesystem::path& file,
+                         const std::map<std::size_t, std::string>& masks);
 
 }  // namespace tilth::recording

@@ -1,9 +1,9 @@
-#include "host_timestamps_csv.h"
+#include "image_folder/host_timestamps_csv.h"
 
 #include <charconv>
 #include <optional>
 
-#include "text_lines.h"
+#include "image_folder/text_lines.h"
 #include "tilth/error.h"
 
 namespace tilth::recording {

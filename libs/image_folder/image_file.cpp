@@ -1,0 +1,30 @@
+#include "image_folder/image_file.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "tilth/error.h"
+#include "tilth/regular_file.h"
+
+namespace tilth::recording {
+
+std::string read_image_bytes(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such file");
+  return read_regular_file(file, kMaxImageBytes, "PNG image");
+}
+
+cv::Mat decode_image(const std::string& bytes, const std::filesystem::path& file) {
+  cv::Mat image;
+  if (!bytes.empty()) {
+    image = cv::imdecode(
+        cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+        cv::IMREAD_UNCHANGED);
+  }
+  if (image.empty()) throw Error(file.string() + ": not a readable image");
+  return image;
+}
+
+cv::Mat read_image_file(const std::filesystem::path& file) {
+  return decode_image(read_image_bytes(file), file);
+}
+
+}  // namespace tilth::recording
