@@ -126,10 +126,6 @@ class Runtime::Impl {
   }
 
   RunResult run() {
-    {
-      std::lock_guard lock(done_mutex_);
-      start_ns_ = steady_now_ns();
-    }
     // This thread works in the flow graph's arena (wait_for_all) until every admitted
     // frame is done; the reservation keeps it there while sources may still admit.
     flow_.reserve_wait();
@@ -184,9 +180,11 @@ class Runtime::Impl {
     result.end_to_end = end_to_end_.summary();
     std::lock_guard lock(done_mutex_);
     result.frames_completed = completed_;
-    if (completed_ > 0 && last_done_ns_ > start_ns_) {
-      result.frames_per_second =
-          static_cast<double>(completed_) / (static_cast<double>(last_done_ns_ - start_ns_) * 1e-9);
+    // From the first frame done: start-up (plugins, calibration, a camera's first frame)
+    // is not part of the rate.
+    if (completed_ > 1 && last_done_ns_ > first_done_ns_) {
+      result.frames_per_second = static_cast<double>(completed_ - 1) /
+                                 (static_cast<double>(last_done_ns_ - first_done_ns_) * 1e-9);
     }
     return result;
   }
@@ -468,8 +466,8 @@ class Runtime::Impl {
       auto it = remaining_.find(info.sequence);
       if (--it->second > 0) return;
       remaining_.erase(it);
-      ++completed_;
       last_done_ns_ = steady_now_ns();
+      if (++completed_ == 1) first_done_ns_ = last_done_ns_;
     }
     end_to_end_.record(host_now_ns() - info.host_timestamp_ns);
     admission_->complete();
@@ -504,7 +502,7 @@ class Runtime::Impl {
   mutable std::mutex done_mutex_;
   std::map<std::uint64_t, std::size_t> remaining_;  // terminal nodes still to finish, per frame
   std::uint64_t completed_ = 0;
-  std::int64_t start_ns_ = 0;
+  std::int64_t first_done_ns_ = 0;
   std::int64_t last_done_ns_ = 0;
   LatencyHistogram end_to_end_;
 

@@ -29,6 +29,8 @@ packages=(
   python3-opencv python3-numpy
   # tilth ab tests: statistics recomputed independently, the report opened in a browser
   python3-scipy chromium
+  # the fleet's job files: a real single-node Slurm cluster, the manifests read as YAML
+  slurmctld slurmd slurm-client munge python3-yaml
   # the live view's test drives Chromium over its DevTools protocol
   python3-websocket
 )

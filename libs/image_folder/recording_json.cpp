@@ -66,7 +66,8 @@ RecordingJson read_recording_json(const fs::path& folder) {
   const json document = parse_json(read_json_text(file, "recording.json"), file.string());
   if (!document.is_object()) fail(file, "", "an object", document);
   for (const auto& [key, value] : document.items()) {
-    if (key != "format" && key != "calibration" && key != "color_format" && key != "description") {
+    if (key != "format" && key != "calibration" && key != "color_format" && key != "description" &&
+        key != "tags") {
       throw Error(file.string() + ":/" + key + ": no such field (misspelt?)");
     }
   }
@@ -87,6 +88,14 @@ RecordingJson read_recording_json(const fs::path& folder) {
   if (const auto it = document.find("description"); it != document.end()) {
     if (!it->is_string()) fail(file, "/description", "a string", *it);
     recording.description = it->get<std::string>();
+  }
+  if (const auto it = document.find("tags"); it != document.end()) {
+    if (!it->is_object())
+      fail(file, "/tags", "an object of strings, e.g. {\"site\": \"north\"}", *it);
+    for (const auto& [key, value] : it->items()) {
+      if (!value.is_string()) fail(file, "/tags/" + key, "a string", value);
+      recording.tags[key] = value.get<std::string>();
+    }
   }
   recording.calibration = read_calibration(required(document, file, "calibration"), folder, file);
   return recording;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "tilth/calibration.h"
@@ -16,6 +17,7 @@ struct RecordingJson {
   RigCalibration calibration;
   PixelFormat color_format = PixelFormat::kBgr8;
   std::string description;
+  std::map<std::string, std::string> tags;  // conditions it was recorded in: site, crop, ...
 };
 
 // Reads <folder>/recording.json, and the calibration file it names; throws tilth::Error

@@ -5,7 +5,9 @@ the simulator's case C at half the paper rig's resolution, so that they take sec
                  soil), frame 2 without truth distance or mask (image folder)
   case_c_mcap    case_c converted to an MCAP file
 then `tilth ab` run twice on them with three variants (once keeping every image, once
-one graph at a time), and graphs/paper.json on case_c for a cross-check."""
+one graph at a time), and graphs/paper.json on case_c for a cross-check. Tags: case_c's
+recording.json says site north and light sun (case_c_hidden copies it), tags.csv moves
+case_c_hidden to site south; the MCAP file has none."""
 import csv
 import json
 import os
@@ -72,6 +74,17 @@ def convert_to_mcap(folder, mcap):
 
 
 VARIANTS = os.path.join(FIXTURE, "variants.json")
+TAGS = os.path.join(FIXTURE, "tags.csv")
+BASELINE = "wide"
+
+
+def tag(folder, tags):
+    path = os.path.join(folder, "recording.json")
+    with open(path) as f:
+        recording = json.load(f)
+    recording["tags"] = tags
+    with open(path, "w") as f:
+        json.dump(recording, f, indent=2)
 
 
 def comparison(out):
@@ -81,7 +94,8 @@ def comparison(out):
             "--variant", "wide:segment.dilation_px=5",
             "--variant", "plane:estimate.type=estimation.ground_plane",
             "--variant", "plane:estimate.calibration=" + CALIBRATION,
-            "--var", "calibration=" + CALIBRATION, "--overlays", "2", "--out", out, "--quiet"]
+            "--var", "calibration=" + CALIBRATION, "--baseline", BASELINE, "--tags", TAGS,
+            "--overlays", "2", "--out", out, "--quiet"]
 
 
 def compare(out, *extra):
@@ -97,6 +111,9 @@ def main():
     os.makedirs(RECORDINGS)
     case_c = os.path.join(RECORDINGS, "case_c")
     simulate("case_c", 3, case_c)
+    tag(case_c, {"site": "north", "light": "sun"})
+    with open(TAGS, "w") as f:
+        f.write("recording,site\ncase_c_hidden,south\n")
     hide_truth(case_c, os.path.join(RECORDINGS, "case_c_hidden"))
     convert_to_mcap(case_c, os.path.join(RECORDINGS, "case_c_mcap.mcap"))
     compare(os.path.join(FIXTURE, "report"), "--keep-images")

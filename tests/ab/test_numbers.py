@@ -27,6 +27,13 @@ TRUTH_FOLDERS = {
     "case_c_mcap": os.path.join(FIXTURE, "recordings", "case_c"),  # converted from it
 }
 NO_SOIL_BELOW = 0.01
+BASELINE = "wide"  # --baseline in make_fixture.py
+# recording -> tags: recording.json's, and tags.csv's over them (make_fixture.py)
+TAGS = {"case_c": {"site": "north", "light": "sun"},
+        "case_c_hidden": {"site": "south", "light": "sun"},
+        "case_c_mcap": {}}
+COVER_BINS = [(0.0, 0.25, "0-25 %"), (0.25, 0.5, "25-50 %"), (0.5, 0.75, "50-75 %"),
+              (0.75, 0.9, "75-90 %"), (0.9, 1.01, "90-100 %")]
 
 
 def close(a, b, tolerance=1e-9):
@@ -74,21 +81,26 @@ def mask_counts(predicted, truth):
             "unknown": int(np.sum(known & (predicted == 128)))}
 
 
+def t_interval(values):
+    """mean -/+ t(0.975, n-1) s / sqrt(n), the one 95 % interval of a report."""
+    mean = statistics.fmean(values)
+    if len(values) < 2:
+        return mean, None, None
+    half = stats.t.ppf(0.975, len(values) - 1) * statistics.stdev(values) / math.sqrt(len(values))
+    return mean, mean - half, mean + half
+
+
 def error_figures(errors):
     n = len(errors)
     if n == 0:
-        return {"count": 0}
-    figures = {"count": n, "mean_mm": statistics.fmean(errors),
-               "mean_abs_mm": statistics.fmean(abs(e) for e in errors),
-               "max_abs_mm": max(abs(e) for e in errors),
-               "rms_mm": math.sqrt(statistics.fmean(e * e for e in errors)),
-               "std_mm": None, "ci95_low_mm": None, "ci95_high_mm": None}
-    if n > 1:
-        std = statistics.stdev(errors)
-        half = stats.t.ppf(0.975, n - 1) * std / math.sqrt(n)
-        figures.update(std_mm=std, ci95_low_mm=figures["mean_mm"] - half,
-                       ci95_high_mm=figures["mean_mm"] + half)
-    return figures
+        return {"frames_with_error_value": 0}
+    mean, low, high = t_interval(errors)
+    return {"frames_with_error_value": n, "mean_mm": mean,
+            "mean_abs_mm": statistics.fmean(abs(e) for e in errors),
+            "max_abs_mm": max(abs(e) for e in errors),
+            "rms_mm": math.sqrt(statistics.fmean(e * e for e in errors)),
+            "std_mm": statistics.stdev(errors) if n > 1 else None,
+            "mean_ci95_low_mm": low, "mean_ci95_high_mm": high}
 
 
 def ratio(a, b):
@@ -125,23 +137,63 @@ class Recomputed:
                 "missed": expected == "valid" and not valid,
                 "false_valid": expected == "no_visible_soil" and valid, "mask": mask}
 
-    def figures(self, jobs):
-        frames = [frame for job in jobs for frame in self.frames[job]]
+    def figures(self, jobs, keep=lambda recording, frame: True):
+        frames = [frame for job in jobs for frame in self.frames[job] if keep(job[1], frame)]
         masks = [frame["mask"] for frame in frames if frame["mask"] is not None]
         total = {key: sum(m[key] for m in masks) for key in ("tp", "fp", "fn", "tn", "unknown")}
         return {
             "frames": len(frames),
-            "valid": sum(f["valid"] for f in frames),
-            "expected_valid": sum(f["expected"] == "valid" for f in frames),
-            "no_visible_soil": sum(f["expected"] == "no_visible_soil" for f in frames),
-            "missed": sum(f["missed"] for f in frames),
-            "false_valid": sum(f["false_valid"] for f in frames),
+            "frames_valid": sum(f["valid"] for f in frames),
+            "frames_expected_valid": sum(f["expected"] == "valid" for f in frames),
+            "frames_without_visible_soil": sum(f["expected"] == "no_visible_soil" for f in frames),
+            "frames_missed": sum(f["missed"] for f in frames),
+            "frames_false_valid": sum(f["false_valid"] for f in frames),
             "error": error_figures([f["error"] for f in frames if f["error"] is not None]),
-            "mask": None if not masks else dict(
-                total, frames=len(masks), iou=ratio(total["tp"], total["tp"] + total["fp"] + total["fn"]),
-                precision=ratio(total["tp"], total["tp"] + total["fp"]),
-                recall=ratio(total["tp"], total["tp"] + total["fn"])),
+            "mask": None if not masks else {
+                "frames_with_both_masks": len(masks),
+                "px_residue_called_residue": total["tp"],
+                "px_soil_called_residue": total["fp"],
+                "px_residue_called_soil_or_unknown": total["fn"],
+                "px_soil_called_soil_or_unknown": total["tn"],
+                "px_called_unknown": total["unknown"],
+                "residue_iou": ratio(total["tp"], total["tp"] + total["fp"] + total["fn"]),
+                "residue_precision": ratio(total["tp"], total["tp"] + total["fp"]),
+                "residue_recall": ratio(total["tp"], total["tp"] + total["fn"])},
         }
+
+    def paired(self, variant, recordings, keep=lambda recording, frame: True):
+        """Against the baseline: per recording the mean of |error| - |baseline's|
+        over the frames with both, then the t interval over those recordings' means."""
+        means, frames = [], 0
+        missed_variant = missed_baseline = 0
+        for recording in recordings:
+            base = {f["frame_id"]: f for f in self.frames[(BASELINE, recording)]
+                    if keep(recording, f)}
+            differences = []
+            for frame in self.frames[(variant, recording)]:
+                if frame["frame_id"] not in base:
+                    continue
+                other = base[frame["frame_id"]]
+                missed_variant += frame["missed"] and not other["missed"]
+                missed_baseline += other["missed"] and not frame["missed"]
+                if frame["error"] is not None and other["error"] is not None:
+                    differences.append(abs(frame["error"]) - abs(other["error"]))
+            if differences:
+                means.append(statistics.fmean(differences))
+                frames += len(differences)
+        mean, low, high = t_interval(means) if means else (None, None, None)
+        if variant == BASELINE:
+            verdict = "baseline"
+        elif low is None:
+            verdict = "too few recordings to tell"
+        else:
+            verdict = ("closer to the truth" if high < 0 else "farther from the truth" if low > 0
+                       else "no clear difference")
+        return {"baseline": BASELINE, "frames_with_both_error_values": frames,
+                "recordings": len(means), "abs_error_difference_mm": mean,
+                "abs_error_difference_ci95_low_mm": low, "abs_error_difference_ci95_high_mm": high,
+                "verdict": verdict, "frames_missed_by_variant_only": missed_variant,
+                "frames_missed_by_baseline_only": missed_baseline}
 
 
 RECOMPUTED = Recomputed()
@@ -214,7 +266,8 @@ class FrameTest(unittest.TestCase):
 
 class SummaryTest(unittest.TestCase):
     def assert_figures(self, reported, expected, where):
-        for key in ("frames", "valid", "expected_valid", "no_visible_soil", "missed", "false_valid"):
+        for key in ("frames", "frames_valid", "frames_expected_valid",
+                    "frames_without_visible_soil", "frames_missed", "frames_false_valid"):
             self.assertEqual(reported[key], expected[key], (where, key))
         for key, value in expected["error"].items():
             self.assertTrue(close(reported["error"][key], value),
@@ -229,8 +282,21 @@ class SummaryTest(unittest.TestCase):
         with open(os.path.join(os.environ["TILTH_SOURCE_DIR"], "CMakeLists.txt")) as f:
             release = re.search(r"project\(Tilth VERSION ([0-9.]+)", f.read()).group(1)
         summary = load_summary(REPORT)
-        self.assertEqual(summary["format"], "tilth-ab/1")
+        self.assertEqual(summary["format"], "tilth-ab/2")
         self.assertEqual(summary["tilth_version"], release)
+
+    def test_the_report_is_stamped_with_how_it_was_made(self):
+        made = load_summary(REPORT)["made"]
+        self.assertEqual(made["tilth_version"], load_summary(REPORT)["tilth_version"])
+        self.assertRegex(made["date_utc"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+        self.assertEqual(made["command_line"][:2], ["tilth", "ab"])
+        self.assertIn("--keep-images", made["command_line"])
+        self.assertEqual(made["command_line"][-1], "--keep-images")
+        self.assertEqual(made["shard_command_lines"], [])
+        with open(os.path.join(REPORT, "report.html")) as f:
+            html = f.read()
+        self.assertIn(made["date_utc"], html)
+        self.assertIn("--baseline wide", html)
 
     def test_per_recording_figures(self):
         summary = load_summary(REPORT)
@@ -261,12 +327,15 @@ class SummaryTest(unittest.TestCase):
         self.assertEqual(len(rows), len(figures))
         for row in rows:
             expected = figures[(row["variant"], row["recording"])]
-            self.assertEqual(int(row["missed"]), expected["missed"])
-            self.assertEqual(int(row["false_valid"]), expected["false_valid"])
+            self.assertEqual(int(row["frames_missed"]), expected["frames_missed"])
+            self.assertEqual(int(row["frames_false_valid"]), expected["frames_false_valid"])
+            self.assertEqual(int(row["frames_with_error_value"]),
+                             expected["error"]["frames_with_error_value"])
             self.assertTrue(close(number(row["error_mean_mm"]), expected["error"].get("mean_mm")))
-            self.assertTrue(close(number(row["error_ci95_low_mm"]),
-                                  expected["error"].get("ci95_low_mm")))
-            self.assertTrue(close(number(row["mask_iou"]), (expected["mask"] or {}).get("iou")))
+            self.assertTrue(close(number(row["error_mean_ci95_low_mm"]),
+                                  expected["error"].get("mean_ci95_low_mm")))
+            self.assertTrue(close(number(row["residue_iou"]),
+                                  (expected["mask"] or {}).get("residue_iou")))
 
     def test_histogram_holds_every_error_in_its_bin(self):
         histogram = load_summary(REPORT)["error_histogram"]
@@ -304,6 +373,7 @@ class SummaryTest(unittest.TestCase):
             for row in summary["variant_figures"] + summary["recording_figures"]:
                 row.pop("stage_times")
                 row.pop("frames_per_second", None)
+            summary.pop("made")
             return summary
 
         self.assertEqual(without_times(load_summary(REPORT)), without_times(load_summary(SERIAL)))
@@ -315,7 +385,119 @@ class SummaryTest(unittest.TestCase):
         best = min(VARIANTS, key=lambda v: RECOMPUTED.figures([(v, "case_c")])["error"]["mean_abs_mm"])
         figures = RECOMPUTED.figures([(best, "case_c")])
         self.assertLessEqual(figures["error"]["mean_abs_mm"], 1.0, best)
-        self.assertEqual(figures["missed"], 0, best)
+        self.assertEqual(figures["frames_missed"], 0, best)
+
+
+def cover_bin(frame):
+    if frame["soil"] is None:
+        return None
+    cover = 1.0 - frame["soil"]
+    return next(label for low, high, label in COVER_BINS if low <= cover < high)
+
+
+class DecisionTest(unittest.TestCase):
+    """Paired comparison with the baseline, and the breakdown by condition."""
+
+    def assert_paired(self, reported, expected, where):
+        for key, value in expected.items():
+            if isinstance(value, float) or value is None:
+                self.assertTrue(close(reported[key], value), (where, key, reported[key], value))
+            else:
+                self.assertEqual(reported[key], value, (where, key))
+
+    def test_each_variant_against_the_baseline(self):
+        summary = load_summary(REPORT)
+        self.assertEqual(summary["baseline"], BASELINE)
+        recordings = sorted(TRUTH_FOLDERS)
+        for row in summary["variant_figures"]:
+            expected = RECOMPUTED.paired(row["variant"], recordings)
+            self.assert_paired(row["against_baseline"], expected, row["variant"])
+        # Against itself every difference is 0; the others have frames in all 3 recordings,
+        # so an interval with 2 degrees of freedom.
+        by_name = {row["variant"]: row["against_baseline"] for row in summary["variant_figures"]}
+        self.assertEqual(by_name[BASELINE]["abs_error_difference_mm"], 0.0)
+        self.assertEqual(by_name["threshold"]["recordings"], 3)
+        self.assertIsNotNone(by_name["threshold"]["abs_error_difference_ci95_low_mm"])
+
+    def test_one_recording_gives_no_interval(self):
+        for row in load_summary(REPORT)["recording_figures"]:
+            expected = RECOMPUTED.paired(row["variant"], [row["recording"]])
+            self.assert_paired(row["against_baseline"], expected, (row["variant"], row["recording"]))
+            if row["variant"] != BASELINE:
+                self.assertEqual(row["against_baseline"]["verdict"], "too few recordings to tell")
+
+    def expected_conditions(self):
+        """(condition, value) -> keep(recording, frame), in the report's order."""
+        conditions = []
+        for low, high, label in COVER_BINS:
+            keep = (lambda label: lambda recording, frame: cover_bin(frame) == label)(label)
+            if any(keep(job[1], f) for job, frames in RECOMPUTED.frames.items() for f in frames):
+                conditions.append((("residue cover (truth mask)", label), keep))
+        keys = sorted({key for tags in TAGS.values() for key in tags})
+        for key in keys:
+            for value in sorted({tags[key] for tags in TAGS.values() if key in tags}):
+                keep = (lambda key, value: lambda recording, frame:
+                        TAGS[recording].get(key) == value)(key, value)
+                conditions.append((("tag " + key, value), keep))
+        return conditions
+
+    def test_figures_by_condition(self):
+        reported = load_summary(REPORT)["conditions"]
+        expected = self.expected_conditions()
+        self.assertEqual([(c["condition"], c["value"]) for c in reported],
+                         [name for name, _ in expected])
+        self.assertIn(("tag site", "south"), [name for name, _ in expected])
+        recordings = sorted(TRUTH_FOLDERS)
+        for condition, (name, keep) in zip(reported, expected):
+            self.assertEqual([v["variant"] for v in condition["variants"]], VARIANTS)
+            for row in condition["variants"]:
+                jobs = [(row["variant"], r) for r in recordings]
+                SummaryTest.assert_figures(self, row["figures"], RECOMPUTED.figures(jobs, keep),
+                                           (name, row["variant"]))
+                self.assert_paired(row["against_baseline"],
+                                   RECOMPUTED.paired(row["variant"], recordings, keep),
+                                   (name, row["variant"]))
+
+    def test_conditions_csv_repeats_the_json(self):
+        with open(os.path.join(REPORT, "conditions.csv")) as f:
+            rows = list(csv.DictReader(f))
+        reported = load_summary(REPORT)["conditions"]
+        self.assertEqual(len(rows), len(reported) * len(VARIANTS))
+        for row, (condition, variant) in zip(rows, ((c, v) for c in reported for v in c["variants"])):
+            self.assertEqual((row["variant"], row["condition"], row["value"]),
+                             (variant["variant"], condition["condition"], condition["value"]))
+            self.assertEqual(int(row["frames"]), variant["figures"]["frames"])
+            self.assertEqual(int(row["frames_missed"]), variant["figures"]["frames_missed"])
+            self.assertEqual(row["verdict"], variant["against_baseline"]["verdict"])
+            self.assertTrue(close(number(row["abs_error_difference_mm"]),
+                                  variant["against_baseline"]["abs_error_difference_mm"]))
+
+    def test_overlays_count_the_residue_called_soil(self):
+        """Each variant's overlay says how many pixels of truly residue it called soil."""
+        with open(os.path.join(REPORT, "report.html")) as f:
+            html = f.read()
+        reported = re.findall(r"<figcaption>([^<:]*): (\d+) px residue called soil</figcaption>",
+                              html)
+        expected = []
+        for entry in load_summary(REPORT)["disagreements"]:
+            for frame in entry["frames"]:
+                images = os.path.join(REPORT, "runs", "%s", entry["recording"], "frames.images")
+                name = "%06d.png" % frame["frame_id"]
+                truth_file = os.path.join(images % VARIANTS[0], "truth", name)
+                if not os.path.exists(truth_file):
+                    continue
+                truth = cv2.imread(truth_file, cv2.IMREAD_UNCHANGED)
+                for variant in VARIANTS:
+                    mask = cv2.imread(os.path.join(images % variant, "mask", name),
+                                      cv2.IMREAD_UNCHANGED)
+                    expected.append((variant, str(int(np.sum((mask == 0) & (truth == 255))))))
+        self.assertEqual(reported, expected)
+        self.assertTrue(any(count != "0" for _, count in expected))
+
+    def test_recordings_carry_their_tags(self):
+        recordings = {r["name"]: r["tags"] for r in load_summary(REPORT)["recordings"]}
+        self.assertEqual(recordings, TAGS)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -22,12 +22,13 @@ def chromium():
 
 
 def render(html_file):
-    """The DOM after the page's scripts ran, and Chromium's log (console messages)."""
+    """The DOM after the page's scripts ran (and the images they load, within a virtual
+    2 s), and Chromium's log (console messages)."""
     with tempfile.TemporaryDirectory() as profile:
         result = subprocess.run(
             [chromium(), "--headless", "--disable-gpu", "--no-sandbox", "--no-first-run",
              "--user-data-dir=" + profile, "--enable-logging=stderr", "--v=0",
-             "--dump-dom", "file://" + os.path.abspath(html_file)],
+             "--virtual-time-budget=2000", "--dump-dom", "file://" + os.path.abspath(html_file)],
             capture_output=True, text=True, timeout=90)
     if result.returncode != 0:
         raise AssertionError("chromium failed (%d): %s" % (result.returncode, result.stderr[-2000:]))
@@ -84,6 +85,39 @@ class ReportRendersTest(unittest.TestCase):
         self.assertTrue(images)
         for source in images:
             self.assertTrue(source.startswith("data:image/jpeg;base64,"), source[:40])
+
+    def test_an_overlay_zooms_at_its_own_resolution(self):
+        """A click on the first overlay opens the viewer at twice the image's own width;
+        + doubles it again, Esc closes it."""
+        probe = """<script>
+window.addEventListener("load", function () {
+  var thumbnail = document.querySelector(".overlays img");
+  var viewer = document.querySelector(".zoom"), image = viewer.querySelector("img");
+  var seen = [];
+  function note() { seen.push(viewer.hidden + ":" + image.style.width); }
+  thumbnail.click();
+  setTimeout(function () {
+    note();
+    document.dispatchEvent(new KeyboardEvent("keydown", {key: "+"}));
+    note();
+    document.dispatchEvent(new KeyboardEvent("keydown", {key: "Escape"}));
+    note();
+    document.body.setAttribute("data-zoom", thumbnail.naturalWidth + "|" + seen.join("|"));
+  }, 200);
+});
+</script>
+</body>"""
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "zoom.html")
+            with open(path, "w") as f:
+                f.write(self.html.replace("</body>", probe, 1))
+            dom, log = render(path)
+        self.assertEqual(console_messages(log), [])
+        zoom = re.search(r'data-zoom="([^"]*)"', dom).group(1).split("|")
+        width = int(zoom[0])
+        self.assertEqual(width, 320)  # the depth grid of the fixture's half-size rig
+        self.assertEqual(zoom[1:], ["false:%dpx" % (2 * width), "false:%dpx" % (4 * width),
+                                    "true:%dpx" % (4 * width)])
 
     def test_uncaught_error_is_seen(self):
         """An error outside the drawing code reaches both the marker and the console log."""

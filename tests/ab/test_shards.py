@@ -2,7 +2,6 @@
 run as three shards, in two folders, merges into the report the single run wrote, apart
 from timings; a shard that did not finish is listed, not dropped; running a shard again
 replaces its results only; shards of different comparisons are refused."""
-import csv
 import json
 import os
 import shutil
@@ -10,14 +9,13 @@ import subprocess
 import tempfile
 import unittest
 
-from make_fixture import FIXTURE, TILTH, comparison
+from fleet_support import assert_same_as_single_run
+from make_fixture import TILTH, comparison
 
 SHARDS = 3
 # Variants x recordings of the fixture's comparison, variant-major as the jobs are.
 VARIANTS = ["threshold", "wide", "plane"]
 RECORDINGS = ["case_c", "case_c_hidden", "case_c_mcap"]
-# What changes from run to run: stage times and frame rates.
-TIMINGS = ("stage_times", "frames_per_second")
 
 
 def run(command):
@@ -35,23 +33,9 @@ def merge(*folders_and_options):
     return run([TILTH, "ab", "merge", *folders_and_options])
 
 
-def without_timings(value):
-    if isinstance(value, dict):
-        return {k: without_timings(v) for k, v in value.items() if k not in TIMINGS}
-    if isinstance(value, list):
-        return [without_timings(v) for v in value]
-    return value
-
-
 def summary(folder):
     with open(os.path.join(folder, "summary.json")) as f:
         return json.load(f)
-
-
-def summary_rows(folder):
-    """summary.csv without its timing column (ms_per_frame)."""
-    with open(os.path.join(folder, "summary.csv")) as f:
-        return [{k: v for k, v in row.items() if k != "ms_per_frame"} for row in csv.DictReader(f)]
 
 
 def job_labels(index):
@@ -78,12 +62,7 @@ class ShardsTest(unittest.TestCase):
         return os.path.join(self.folder, name)
 
     def assert_same_report(self, merged):
-        single = os.path.join(FIXTURE, "report")
-        self.assertEqual(without_timings(summary(merged)), without_timings(summary(single)))
-        self.assertEqual(summary_rows(merged), summary_rows(single))
-        with open(os.path.join(merged, "frames.csv")) as a, \
-                open(os.path.join(single, "frames.csv")) as b:
-            self.assertEqual(a.read(), b.read())
+        assert_same_as_single_run(self, merged)
 
     def test_merged_shards_give_the_single_runs_report(self):
         result = merge(self.shared, self.other, "--out", self.out("merged"), "--quiet")
@@ -94,6 +73,11 @@ class ShardsTest(unittest.TestCase):
         # The overlays read the masks each shard saved: two frames of each recording.
         self.assertEqual([len(d["frames"]) for d in merged["disagreements"]], [2, 2, 2])
         self.assertTrue(os.path.getsize(os.path.join(self.out("merged"), "report.html")) > 100000)
+        # Stamped with the merge's command line and each shard's.
+        made = merged["made"]
+        self.assertEqual(made["command_line"][:3], ["tilth", "ab", "merge"])
+        self.assertEqual(sorted(line[line.index("--shard") + 1] for line in made["shard_command_lines"]),
+                         ["0/3", "1/3", "2/3"])
 
     def test_a_shard_that_did_not_finish_is_listed_and_fails_the_merge(self):
         result = merge(self.shared, "--out", self.out("partial"), "--quiet")

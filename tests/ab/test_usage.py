@@ -115,6 +115,28 @@ class UsageTest(unittest.TestCase):
                             variants + ":/variants/0/set: expected each key once in an object, "
                             "got \"set\" again")
 
+    def test_unknown_baseline(self):
+        self.assert_refused(ab(CASE_C, "--variant", "a", "--variant", "b:segment.dilation_px=2",
+                               "--baseline", "c", "--out", self.out),
+                            "--baseline c: no such variant; the variants are a, b")
+
+    def test_tags_file_problems(self):
+        tags = os.path.join(self.folder, "tags.csv")
+        for text, message in [
+                ("site\ncase_c,north\n", tags + ":1: expected the header recording,KEY..."),
+                ("recording,\ncase_c,north\n", tags + ":1: column 2 has no tag name"),
+                ("recording,site\ncase_c,north,x\n", tags + ":2: 3 fields, expected 2"),
+                ("recording,site\n\ncase_d,north\n",
+                 tags + ":3: no recording named 'case_d' among the 1 given"),
+                ('recording,site\ncase_c,"north, upper"\n', tags + ":2: quotes are not read"),
+                ("", tags + ": empty")]:
+            with open(tags, "w") as f:
+                f.write(text)
+            self.assert_refused(ab(CASE_C, "--variant", "a", "--tags", tags, "--out", self.out),
+                                message)
+        self.assert_refused(ab(CASE_C, "--variant", "a", "--tags", tags + ".missing", "--out",
+                               self.out), tags + ".missing: cannot read the tags file")
+
     def test_numbers_are_read_whole(self):
         for option, text, expected in [
                 ("--jobs", "2x", "--jobs: expected a whole number in [1, 256], got '2x'"),

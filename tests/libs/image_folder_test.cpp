@@ -1,6 +1,6 @@
 // libs/image_folder: the mask column of frames.csv rewritten in place (what `tilth
 // recording import-masks` relies on to leave every other byte as it was), frames' file
-// names, and image files read with errors that name them.
+// names, image files read with errors that name them, and recording.json's tags.
 #include <fstream>
 #include <sstream>
 
@@ -9,6 +9,8 @@
 
 #include "image_folder/frames_csv.h"
 #include "image_folder/image_file.h"
+#include "image_folder/recording_json.h"
+#include "source_tree.h"
 #include "temp_dir.h"
 #include "tilth/error.h"
 
@@ -65,6 +67,44 @@ TEST(RewriteMaskColumn, AddsTheColumnAtTheEndWhenThereIsNone) {
 TEST(FrameFileName, IsTheIndexInSixDigitsOrMore) {
   EXPECT_EQ(frame_file_name(12), "000012.png");
   EXPECT_EQ(frame_file_name(1234567), "1234567.png");
+}
+
+// recording.json with the shipped paper rig and `extra` fields.
+std::filesystem::path recording_json_with(const testing::TempDir& dir, const std::string& extra) {
+  dir.write("recording.json", R"({"format": "tilth-image-folder/1", "color_format": "bgr8",
+                                  "calibration": ")" +
+                                  testing::paper_rig_path().string() + "\"" + extra + "}");
+  return dir.path();
+}
+
+std::string error_of(const std::filesystem::path& folder) {
+  try {
+    read_recording_json(folder);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+TEST(RecordingJson, ReadsTagsAsStrings) {
+  testing::TempDir dir;
+  const auto folder =
+      recording_json_with(dir, R"(, "tags": {"site": "north field", "crop": "wheat"})");
+  const RecordingJson recording = read_recording_json(folder);
+  EXPECT_EQ(recording.tags,
+            (std::map<std::string, std::string>{{"crop", "wheat"}, {"site", "north field"}}));
+  EXPECT_TRUE(read_recording_json(recording_json_with(dir, "")).tags.empty());
+}
+
+TEST(RecordingJson, RefusesTagsThatAreNotStrings) {
+  testing::TempDir dir;
+  const std::string file = (dir.path() / "recording.json").string();
+  EXPECT_EQ(error_of(recording_json_with(dir, R"(, "tags": ["north"])")),
+            file +
+                ":/tags: expected an object of strings, e.g. {\"site\": \"north\"}, got "
+                "[\"north\"]");
+  EXPECT_EQ(error_of(recording_json_with(dir, R"(, "tags": {"rows": 12})")),
+            file + ":/tags/rows: expected a string, got 12");
 }
 
 TEST(ReadImageFile, DecodesUnchangedAndNamesTheFileInErrors) {

@@ -24,15 +24,20 @@ void note_max(std::atomic<int>& max, int value) {
   }
 }
 
-// Emits 0, step, 2 step, ... `count` frames (0: endless); optionally paced.
+// Emits 0, step, 2 step, ... `count` frames (0: endless); optionally paced, and late to
+// start (as a camera's first frame).
 class Counter final : public Source {
  public:
   explicit Counter(const StageContext& c)
       : count_(c.params.integer("count")),
         period_us_(c.params.integer("period_us")),
+        start_delay_us_(c.params.integer("start_delay_us")),
         step_(c.params.integer("step")) {}
   bool produce(Frame& frame) override {
     if (count_ > 0 && produced_ >= count_) return false;
+    if (produced_ == 0 && start_delay_us_ > 0) {
+      std::this_thread::sleep_for(std::chrono::microseconds(start_delay_us_));
+    }
     if (period_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(period_us_));
     const std::int64_t value = produced_++ * step_;
     frame.set_capture(static_cast<std::uint64_t>(value), value * 1000, 0);
@@ -44,6 +49,7 @@ class Counter final : public Source {
  private:
   const std::int64_t count_;
   const std::int64_t period_us_;
+  const std::int64_t start_delay_us_;
   const std::int64_t step_;
   std::int64_t produced_ = 0;
   std::atomic<bool> interrupted_{false};
@@ -201,6 +207,9 @@ void register_test_stages(StageRegistry& registry) {
       describe("test.counter", {}, {count("out")},
                {ParamSpec::integer("count", 10).range(0, std::nullopt).describe("frames"),
                 ParamSpec::integer("period_us", 0).range(0, std::nullopt).describe("pace"),
+                ParamSpec::integer("start_delay_us", 0)
+                    .range(0, std::nullopt)
+                    .describe("before the first frame"),
                 ParamSpec::integer("step", 1).range(1, std::nullopt).describe("increment")},
                Concurrency::kSerial, factory<Counter>()),
       "test_stages");

@@ -4,6 +4,12 @@
 
 namespace tilth::ab {
 
+std::vector<std::string> command_line_of(const std::vector<std::string>& arguments) {
+  std::vector<std::string> line{"tilth", "ab"};
+  line.insert(line.end(), arguments.begin(), arguments.end());
+  return line;
+}
+
 Figures Comparison::recording_figures(std::size_t variant, std::size_t recording) const {
   return figures_of({&job(variant, recording).frames});
 }

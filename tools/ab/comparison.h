@@ -28,11 +28,23 @@ struct JobResult {
   std::filesystem::path images;  // the images its evaluation sink saved, if it saved them
 };
 
+// How a report was made, stamped on it so that its figures can be traced to a run.
+struct ReportStamp {
+  std::vector<std::string> command_line;  // of the run, or of the merge
+  std::filesystem::path working_directory;
+  std::vector<std::vector<std::string>> shard_command_lines;  // a merge's shards'
+};
+
+// "tilth", "ab", then the arguments of `tilth ab` as given.
+std::vector<std::string> command_line_of(const std::vector<std::string>& arguments);
+
 struct Comparison {
   std::vector<Variant> variants;
   std::vector<Recording> recordings;
   std::vector<JobResult> jobs;  // variant-major: jobs[v * recordings.size() + r]
   double no_soil_below = 0.01;
+  std::size_t baseline = 0;  // the variant the others are paired with
+  ReportStamp stamp;
 
   const JobResult& job(std::size_t variant, std::size_t recording) const {
     return jobs[variant * recordings.size() + recording];

@@ -186,7 +186,12 @@ int run(Options options) {
     return kExitFailed;
   }
   if (options.shard) return finish_shard(options, jobs, runs);
-  Comparison comparison{options.variants, options.recordings, {}, options.no_soil_below};
+  Comparison comparison{options.variants,
+                        options.recordings,
+                        {},
+                        options.no_soil_below,
+                        options.baseline,
+                        {command_line_of(options.arguments), options.working_directory, {}}};
   for (std::size_t j = 0; j < runs.size(); ++j) {
     comparison.jobs.push_back(
         job_result(runs[j], jobs.files[j], jobs.labels[j], options.no_soil_below));

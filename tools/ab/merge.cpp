@@ -69,8 +69,8 @@ std::vector<ShardResults> finished_shards(const std::vector<std::string>& folder
     }
     if (manifest.comparison != first.comparison) {
       throw Error(manifest.file.string() + " and " + first.file.string() +
-                  " ran different comparisons (their variants, recordings, variables, "
-                  "--no-soil-below or --overlays differ)");
+                  " ran different comparisons (their variants, baseline, recordings, tags, "
+                  "variables, --no-soil-below or --overlays differ)");
     }
   }
   return shards;
@@ -125,7 +125,17 @@ std::map<std::size_t, const ShardResults*> job_owners(const std::vector<ShardRes
   return owners;
 }
 
-int merge(const cli::CommandLine& line) {
+// The merge's own command line, and each shard's.
+ReportStamp merge_stamp(const std::vector<std::string>& arguments,
+                        const std::vector<ShardResults>& shards) {
+  ReportStamp stamp{command_line_of(arguments), fs::current_path(), {}};
+  for (const auto& shard : shards) {
+    stamp.shard_command_lines.push_back(command_line_of(shard.manifest.arguments));
+  }
+  return stamp;
+}
+
+int merge(const cli::CommandLine& line, const std::vector<std::string>& arguments) {
   if (line.positional().empty()) throw MergeUsageError("no shard folder given");
   const auto out = line.value("--out");
   if (!out) throw MergeUsageError("--out DIR is required");
@@ -135,7 +145,8 @@ int merge(const cli::CommandLine& line) {
   const std::size_t recordings = options.recordings.size();
   const auto owners = job_owners(shards, options.variants.size() * recordings);
 
-  Comparison comparison{options.variants, options.recordings, {}, options.no_soil_below};
+  Comparison comparison{options.variants,      options.recordings, {},
+                        options.no_soil_below, options.baseline,   merge_stamp(arguments, shards)};
   std::vector<std::string> missing;
   for (std::size_t v = 0; v < options.variants.size(); ++v) {
     for (std::size_t r = 0; r < recordings; ++r) {
@@ -192,7 +203,7 @@ int merge_command(int argc, char** argv) {
       std::cout << kMergeUsage;
       return kExitOk;
     }
-    return merge(*line);
+    return merge(*line, std::vector<std::string>(argv + 1, argv + argc));
   } catch (const MergeUsageError& error) {
     std::cerr << "tilth ab merge: " << error.what() << "\n\n" << kMergeUsage;
     return kExitUsage;

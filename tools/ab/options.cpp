@@ -1,10 +1,12 @@
 #include "options.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <thread>
 
 #include "command_line.h"
 #include "framework/install_layout.h"
+#include "recording_tags.h"
 #include "variant_specs.h"
 
 namespace tilth::ab {
@@ -39,6 +41,10 @@ jobs that no shard finished (exit code 1).
   --variants FILE           variants from a JSON file
   --chain FILE              the chain the variants change
                             (default: graphs/measurement-chain.json)
+  --baseline NAME           the variant every other is paired with on the same frames
+                            (default: the first)
+  --tags FILE               recording tags (site, crop, ...) to break figures down by:
+                            CSV with the header recording,KEY... (docs/ab-testing.md)
   --var NAME=VALUE          a graph variable for every graph, e.g. calibration=FILE
   --out DIR                 where the report goes (default: ab-report); missing or empty
   --overwrite               replace an earlier report in DIR
@@ -70,12 +76,18 @@ fs::path default_chain(const cli::CommandLine& line) {
   return shipped_data_dir() / "graphs" / "measurement-chain.json";
 }
 
+std::string variant_names(const std::vector<Variant>& variants) {
+  std::string names;
+  for (const auto& variant : variants) names += (names.empty() ? "" : ", ") + variant.name;
+  return names;
+}
+
 }  // namespace
 
 Options parse_options(int argc, char** argv) {
   const cli::CommandLine line(argc, argv, 1,
                               {"--variant", "--variants", "--chain", "--var", "--out", "--jobs",
-                               "--overlays", "--no-soil-below", "--shard"},
+                               "--overlays", "--no-soil-below", "--shard", "--baseline", "--tags"},
                               {"--help", "--overwrite", "--keep-images", "--quiet", "--verbose"});
   Options options;
   options.help = line.flag("--help");
@@ -91,6 +103,17 @@ Options parse_options(int argc, char** argv) {
     add_variant_option(option, chain, options.variants);
   }
   if (options.variants.empty()) throw UsageError("no variant given: use --variant or --variants");
+  if (const auto baseline = line.value("--baseline")) {
+    const auto found =
+        std::find_if(options.variants.begin(), options.variants.end(),
+                     [&](const Variant& variant) { return variant.name == *baseline; });
+    if (found == options.variants.end()) {
+      throw UsageError("--baseline " + *baseline + ": no such variant; the variants are " +
+                       variant_names(options.variants));
+    }
+    options.baseline = static_cast<std::size_t>(found - options.variants.begin());
+  }
+  if (const auto tags = line.value("--tags")) apply_tags_file(*tags, options.recordings);
   for (const auto& variable : line.values("--var")) {
     options.variables.variables.push_back(parse_setting("--var", variable));
   }

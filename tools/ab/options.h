@@ -21,6 +21,7 @@ extern const char* const kUsage;
 struct Options {
   std::vector<Recording> recordings;
   std::vector<Variant> variants;
+  std::size_t baseline = 0;  // the variant the others are paired with (--baseline)
   GraphOverrides variables;  // --var
   OutputLayout layout;
   bool overwrite = false;

@@ -19,7 +19,7 @@ void prepare_output(const OutputLayout& layout, bool overwrite) {
                   ": folder holds no summary.json; not overwriting a folder that is not a report");
     }
     for (const auto& path : {layout.report(), layout.summary_json(), layout.summary_csv(),
-                             layout.frames_csv(), layout.runs()}) {
+                             layout.conditions_csv(), layout.frames_csv(), layout.runs()}) {
       fs::remove_all(path, error);
       if (error) throw Error(path.string() + ": cannot remove: " + error.message());
     }

@@ -1,5 +1,5 @@
 // Where a comparison's files go under the output folder:
-//   report.html  summary.json  summary.csv  frames.csv
+//   report.html  summary.json  summary.csv  conditions.csv  frames.csv
 //   runs/VARIANT/RECORDING/graph.json  frames.jsonl  frames.images/{mask,truth,color}/
 //                          job.json (a shard's jobs, job_record.h)
 //   shards/I-of-N.json     (a shard's manifest, shard_manifest.h)
@@ -19,6 +19,7 @@ struct OutputLayout {
   std::filesystem::path report() const { return dir / "report.html"; }
   std::filesystem::path summary_json() const { return dir / "summary.json"; }
   std::filesystem::path summary_csv() const { return dir / "summary.csv"; }
+  std::filesystem::path conditions_csv() const { return dir / "conditions.csv"; }
   std::filesystem::path frames_csv() const { return dir / "frames.csv"; }
   std::filesystem::path runs() const { return dir / "runs"; }
   std::filesystem::path shards() const { return dir / "shards"; }

@@ -7,7 +7,6 @@
 #include <tuple>
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "data_uri.h"
 
@@ -16,15 +15,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// BGR tints, blended half and half over the colour.
-const cv::Vec3b kAgreedResidue{0, 220, 255};   // yellow: residue called residue
-const cv::Vec3b kFalseResidue{40, 40, 230};    // red: soil called residue
-const cv::Vec3b kMissedResidue{230, 120, 30};  // blue: residue left in the soil depth
-const cv::Vec3b kUnknown{160, 160, 160};       // grey: called unknown / truth unknown
+// BGR; blended half and half over the colour, except residue called soil, which is
+// painted over it: it reaches the soil depth and so the distance, the costliest mistake.
+struct Tint {
+  cv::Vec3b bgr;
+  bool opaque = false;
+};
+const Tint kAgreedResidue{{0, 220, 255}};        // yellow: residue called residue
+const Tint kFalseResidue{{40, 40, 230}};         // red: soil called residue
+const Tint kMissedResidue{{255, 0, 255}, true};  // magenta: residue left in the soil depth
+const Tint kUnknown{{160, 160, 160}};            // grey: called unknown / truth unknown
 constexpr std::uint8_t kResidue = 255;
 constexpr std::uint8_t kUnknownValue = 128;
-constexpr int kMaxPanelWidth = 320;  // as the report shows them
-constexpr int kJpegQuality = 90;
+constexpr int kJpegQuality = 92;
 
 struct Disagreement {
   std::uint64_t frame_id = 0;
@@ -50,13 +53,13 @@ cv::Mat read_image(const fs::path& file, int flags) {
   return cv::imread(file.string(), flags);
 }
 
-const cv::Vec3b* truth_tint(std::uint8_t truth) {
+const Tint* truth_tint(std::uint8_t truth) {
   if (truth == kResidue) return &kAgreedResidue;
   return truth == kUnknownValue ? &kUnknown : nullptr;
 }
 
 // Judged against the truth when there is one; pixels of unknown truth are not judged.
-const cv::Vec3b* mask_tint(std::uint8_t called, const std::uint8_t* truth) {
+const Tint* mask_tint(std::uint8_t called, const std::uint8_t* truth) {
   if (called == kUnknownValue) return &kUnknown;
   const bool residue = called == kResidue;
   if (truth == nullptr) return residue ? &kAgreedResidue : nullptr;
@@ -66,30 +69,29 @@ const cv::Vec3b* mask_tint(std::uint8_t called, const std::uint8_t* truth) {
   return truly_residue ? &kMissedResidue : nullptr;
 }
 
-// `tint_of(i)` for pixel i (row-major): a colour blended half and half, or none.
+// `tint_of(i)` for pixel i (row-major): a tint, or none.
 template <class TintOf>
 cv::Mat tinted(const cv::Mat& base, TintOf tint_of) {
   cv::Mat out = base.clone();
   for (int y = 0; y < out.rows; ++y) {
     auto* row = out.ptr<cv::Vec3b>(y);
     for (int x = 0; x < out.cols; ++x) {
-      const cv::Vec3b* tint = tint_of(static_cast<std::size_t>(y) * out.cols + x);
+      const Tint* tint = tint_of(static_cast<std::size_t>(y) * out.cols + x);
       if (tint == nullptr) continue;
+      if (tint->opaque) {
+        row[x] = tint->bgr;
+        continue;
+      }
       for (int c = 0; c < 3; ++c) {
-        row[x][c] = static_cast<std::uint8_t>((row[x][c] + (*tint)[c]) / 2);
+        row[x][c] = static_cast<std::uint8_t>((row[x][c] + tint->bgr[c]) / 2);
       }
     }
   }
   return out;
 }
 
-std::string panel_uri(const cv::Mat& image) {
-  if (image.cols <= kMaxPanelWidth) return jpeg_data_uri(image, kJpegQuality);
-  cv::Mat small;
-  const double scale = static_cast<double>(kMaxPanelWidth) / image.cols;
-  cv::resize(image, small, {}, scale, scale, cv::INTER_AREA);
-  return jpeg_data_uri(small, kJpegQuality);
-}
+// At full resolution: the report shows it small and zooms in on a click.
+std::string panel_uri(const cv::Mat& image) { return jpeg_data_uri(image, kJpegQuality); }
 
 std::string describe(const Disagreement& d) {
   char text[160];
@@ -173,10 +175,15 @@ OverlayFrame overlay_frame(const Comparison& comparison, std::size_t recording,
       frame.panels.push_back({name + ": no mask", ""});
       continue;
     }
-    frame.panels.push_back({name, panel_uri(tinted(color, [&](std::size_t i) {
-                              return mask_tint(mask.data[i],
-                                               truth.empty() ? nullptr : &truth.data[i]);
-                            }))});
+    std::size_t missed = 0;
+    const cv::Mat panel = tinted(color, [&](std::size_t i) {
+      const Tint* tint = mask_tint(mask.data[i], truth.empty() ? nullptr : &truth.data[i]);
+      missed += tint == &kMissedResidue ? 1 : 0;
+      return tint;
+    });
+    frame.panels.push_back(
+        {truth.empty() ? name : name + ": " + std::to_string(missed) + " px residue called soil",
+         panel_uri(panel)});
   }
   return frame;
 }

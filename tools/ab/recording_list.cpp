@@ -4,6 +4,7 @@
 #include <fstream>
 #include <set>
 
+#include "image_folder/recording_json.h"
 #include "tilth/error.h"
 
 namespace tilth::ab {
@@ -32,6 +33,16 @@ std::optional<std::size_t> count_frames(const fs::path& folder) {
   return lines > 0 ? lines - 1 : 0;
 }
 
+// A recording.json that cannot be read has no tags here: its replay fails, and the report
+// lists that job's failure beside the other jobs' results.
+std::map<std::string, std::string> tags_of(const fs::path& folder) {
+  try {
+    return recording::read_recording_json(folder).tags;
+  } catch (const Error&) {
+    return {};
+  }
+}
+
 Recording make_recording(const fs::path& path) {
   const fs::path absolute = fs::absolute(path).lexically_normal();
   std::string name = is_mcap(path) ? absolute.stem().string() : absolute.filename().string();
@@ -39,8 +50,8 @@ Recording make_recording(const fs::path& path) {
   for (char& c : name) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
   }
-  if (is_mcap(path)) return {name, absolute, RecordingFormat::kMcap, std::nullopt};
-  return {name, absolute, RecordingFormat::kImageFolder, count_frames(absolute)};
+  if (is_mcap(path)) return {name, absolute, RecordingFormat::kMcap, std::nullopt, {}};
+  return {name, absolute, RecordingFormat::kImageFolder, count_frames(absolute), tags_of(absolute)};
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,7 +17,8 @@ struct Recording {
   std::string name;  // the folder name or file stem, made unique; letters, digits, '-', '_'
   std::filesystem::path path;  // absolute
   RecordingFormat format;
-  std::optional<std::size_t> frames;  // from frames.csv; unknown for MCAP until replayed
+  std::optional<std::size_t> frames;        // from frames.csv; unknown for MCAP until replayed
+  std::map<std::string, std::string> tags;  // conditions it was recorded in: site, crop, ...
 };
 
 // The stage type that replays the format ("recording.image_folder", "mcap.player").

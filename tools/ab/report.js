@@ -214,7 +214,66 @@
     legend(figure, plot, variants.map(function (name, v) { return {label: name, color: color(v)}; }));
   }
 
+  // A click on an overlay shows it at its own resolution times a zoom (wheel, + and -),
+  // over the page; Esc or a click outside the image closes it.
+  function zoomViewer() {
+    var viewer = document.createElement("div");
+    viewer.className = "zoom";
+    viewer.hidden = true;
+    var bar = document.createElement("div");
+    bar.className = "zoom-bar";
+    var caption = document.createElement("span");
+    var scroller = document.createElement("div");
+    scroller.className = "zoom-area";
+    var image = document.createElement("img");
+    scroller.appendChild(image);
+    var scale = 1;
+    function show() {
+      image.style.width = image.naturalWidth * scale + "px";
+      caption.textContent = image.alt + " \u2014 " + image.naturalWidth + "\u00d7" +
+          image.naturalHeight + " px, zoom " + scale + "\u00d7";
+    }
+    function zoom(factor) {
+      scale = Math.min(16, Math.max(1, scale * factor));
+      show();
+    }
+    function close() { viewer.hidden = true; }
+    [["\u2212", function () { zoom(0.5); }], ["+", function () { zoom(2); }],
+     ["\u00d7", close]].forEach(function (entry) {
+      var button = document.createElement("button");
+      button.textContent = entry[0];
+      button.addEventListener("click", entry[1]);
+      bar.appendChild(button);
+    });
+    bar.appendChild(caption);
+    viewer.appendChild(bar);
+    viewer.appendChild(scroller);
+    document.body.appendChild(viewer);
+    scroller.addEventListener("wheel", function (event) {
+      event.preventDefault();
+      zoom(event.deltaY < 0 ? 2 : 0.5);
+    });
+    scroller.addEventListener("click", function (event) { if (event.target === scroller) close(); });
+    document.addEventListener("keydown", function (event) {
+      if (viewer.hidden) return;
+      if (event.key === "Escape") close();
+      if (event.key === "+" || event.key === "=") zoom(2);
+      if (event.key === "-") zoom(0.5);
+    });
+    document.querySelectorAll(".overlays img").forEach(function (thumbnail) {
+      thumbnail.addEventListener("click", function () {
+        image.onload = show;
+        image.alt = thumbnail.alt;
+        image.src = thumbnail.src;
+        scale = 2;
+        viewer.hidden = false;
+        if (image.complete) show();
+      });
+    });
+  }
+
   try {
+    zoomViewer();
     var data = JSON.parse(document.getElementById("ab-data").textContent);
     var drawn = 0;
     document.querySelectorAll("figure.plot").forEach(function (figure) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "overlays.h"
+#include "paired.h"
 #include "report_html.h"
 #include "report_numbers.h"
 
@@ -28,21 +29,28 @@ void write_report(const Comparison& comparison, const OutputLayout& layout, std:
   const auto summary = summary_json(comparison, shown);
   write_text(layout.summary_json(), summary.dump(2) + "\n");
   write_summary_csv(comparison, layout.summary_csv());
+  write_conditions_csv(comparison, layout.conditions_csv());
   write_frames_csv(comparison, layout.frames_csv());
   write_text(layout.report(), report_html(comparison, summary, shown));
 }
 
 void print_summary(const Comparison& comparison, const OutputLayout& layout) {
-  std::printf("%-24s %7s %7s %7s %7s %12s %12s %7s\n", "variant", "frames", "valid", "missed",
-              "f.valid", "mean|err|mm", "max|err|mm", "IoU");
+  std::printf("%-16s %7s %7s %7s %7s %11s %11s %7s  %s\n", "variant", "frames", "valid", "missed",
+              "false", "mean|err|", "max|err|", "residue", "against the baseline");
+  std::printf("%-16s %7s %7s %7s %7s %11s %11s %7s\n", "", "", "", "", "valid", "mm", "mm", "IoU");
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
     const Figures f = comparison.variant_figures(v);
     const bool errors = f.error.count > 0;
-    std::printf("%-24s %7zu %7zu %7zu %7zu %12s %12s %7s\n", comparison.variants[v].name.c_str(),
-                f.frames, f.valid, f.missed, f.false_valid,
+    const PairedFigures paired = paired_figures(comparison, v);
+    std::string against = distance_verdict(comparison, v, paired);
+    if (v != comparison.baseline && paired.abs_error_difference_mm) {
+      against += " (" + column(paired.abs_error_difference_mm, "%+.3f") + " mm)";
+    }
+    std::printf("%-16s %7zu %7zu %7zu %7zu %11s %11s %7s  %s\n",
+                comparison.variants[v].name.c_str(), f.frames, f.valid, f.missed, f.false_valid,
                 column(errors ? std::optional(f.error.mean_abs_mm) : std::nullopt, "%.3f").c_str(),
                 column(errors ? std::optional(f.error.max_abs_mm) : std::nullopt, "%.3f").c_str(),
-                column(f.mask ? f.mask->iou() : std::nullopt, "%.3f").c_str());
+                column(f.mask ? f.mask->iou() : std::nullopt, "%.3f").c_str(), against.c_str());
   }
   std::printf("report: %s\n", layout.report().c_str());
 }

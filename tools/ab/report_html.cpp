@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "conditions.h"
+#include "paired.h"
 #include "report_assets.h"
 
 namespace tilth::ab {
@@ -62,28 +64,44 @@ double ms_per_frame(const std::vector<StageTime>& stages) {
   return total;
 }
 
+// Fewer frames than this give stage times dominated by the first frames' set-up.
+constexpr std::uint64_t kMinFramesToTime = 30;
+
 const char* kFiguresHeader =
-    "<th>frames</th><th>valid</th><th>missed</th><th>false valid</th><th>errors</th>"
-    "<th>mean error (mm)</th><th>std (mm)</th><th>mean |error| (mm)</th>"
-    "<th>max |error| (mm)</th><th>95% CI of mean error (mm)</th><th>mask IoU</th>"
-    "<th>precision</th><th>recall</th><th>ms / frame</th>";
+    "<th>frames</th><th>frames valid</th><th>frames missed</th><th>frames false valid</th>"
+    "<th>frames with an error value</th><th>mean error (mm)</th><th>std of error (mm)</th>"
+    "<th>mean |error| (mm)</th><th>max |error| (mm)</th><th>95% CI of mean error (mm)</th>"
+    "<th>residue IoU</th><th>residue precision</th><th>residue recall</th>"
+    "<th>chain ms / frame</th>";
+
+std::string interval(const std::optional<double>& low, const std::optional<double>& high) {
+  if (!low) return "&ndash;";
+  return "[" + signed_fixed(low) + ", " + signed_fixed(high) + "]";
+}
+
+// Stage times over too few frames say more about set-up than about the stages.
+std::string chain_time(const std::vector<StageTime>& stages) {
+  if (stages.empty()) return "&ndash;";
+  if (stages.front().latency.count < kMinFramesToTime) {
+    return "<span title=\"fewer than " + std::to_string(kMinFramesToTime) +
+           " frames: not a meaningful time\">(" + fixed(ms_per_frame(stages)) + ")</span>";
+  }
+  return fixed(ms_per_frame(stages));
+}
 
 std::string figure_cells(const Figures& f, const std::vector<StageTime>& stages, bool best) {
   const ErrorStats& e = f.error;
   const auto mask = [&](std::optional<double> (MaskCounts::*ratio)() const) {
     return f.mask ? fixed(((*f.mask).*ratio)(), 3) : std::string("&ndash;");
   };
-  std::string ci = "&ndash;";
-  if (e.ci95_low_mm)
-    ci = "[" + signed_fixed(e.ci95_low_mm) + ", " + signed_fixed(e.ci95_high_mm) + "]";
   return cell(std::to_string(f.frames)) + cell(std::to_string(f.valid)) +
          cell(std::to_string(f.missed), f.missed > 0 ? "bad" : "") +
          cell(std::to_string(f.false_valid), f.false_valid > 0 ? "bad" : "") +
          cell(std::to_string(e.count)) + cell(signed_fixed(if_any(e, e.mean_mm))) +
          cell(fixed(e.std_mm)) + cell(fixed(if_any(e, e.mean_abs_mm)), best ? "best" : "") +
-         cell(fixed(if_any(e, e.max_abs_mm))) + cell(ci) + cell(mask(&MaskCounts::iou)) +
-         cell(mask(&MaskCounts::precision)) + cell(mask(&MaskCounts::recall)) +
-         cell(stages.empty() ? "&ndash;" : fixed(ms_per_frame(stages)));
+         cell(fixed(if_any(e, e.max_abs_mm))) + cell(interval(e.ci95_low_mm, e.ci95_high_mm)) +
+         cell(mask(&MaskCounts::iou)) + cell(mask(&MaskCounts::precision)) +
+         cell(mask(&MaskCounts::recall)) + cell(chain_time(stages));
 }
 
 // The variant with the smallest mean |error| among those with errors, if any.
@@ -131,6 +149,107 @@ std::string summary_section(const Comparison& comparison) {
   return html + "</table>\n";
 }
 
+std::string verdict_cell(const std::string& verdict) {
+  if (verdict == "closer to the truth") return cell(verdict, "name best");
+  if (verdict == "farther from the truth") return cell(verdict, "name bad");
+  return cell(verdict, "name");
+}
+
+std::string count_cell(std::size_t count) {
+  return cell(std::to_string(count), count > 0 ? "bad" : "");
+}
+
+const char* kPairedHeader =
+    "<th>frames with an error value in both</th><th>recordings</th>"
+    "<th>mean |error| difference (mm)</th><th>95% CI over recordings (mm)</th>"
+    "<th class=\"name\">distance verdict</th><th>frames missed, baseline valid</th>"
+    "<th>frames valid, baseline missed</th><th>frames false valid, baseline not</th>"
+    "<th>frames not false valid, baseline was</th>";
+
+std::string paired_cells(const Comparison& comparison, std::size_t variant) {
+  const PairedFigures p = paired_figures(comparison, variant);
+  return cell(std::to_string(p.frames_with_both_errors)) + cell(std::to_string(p.recordings)) +
+         cell(signed_fixed(p.abs_error_difference_mm)) +
+         cell(interval(p.ci95_low_mm, p.ci95_high_mm)) +
+         verdict_cell(distance_verdict(comparison, variant, p)) +
+         count_cell(p.missed_by_variant_only) + cell(std::to_string(p.missed_by_baseline_only)) +
+         count_cell(p.false_valid_by_variant_only) +
+         cell(std::to_string(p.false_valid_by_baseline_only));
+}
+
+std::string baseline_section(const Comparison& comparison) {
+  const std::string& baseline = comparison.variants[comparison.baseline].name;
+  std::string html =
+      "<h2>Against the baseline, " + escape(baseline) +
+      "</h2>\n<p class=\"note\">Each variant on the same frames as the baseline: the "
+      "difference of |error| (variant &minus; baseline; negative is closer to the truth) "
+      "averaged per recording, then over recordings. The 95% interval takes each recording "
+      "as one observation (Student's t over the recordings' means), because the frames of "
+      "one recording are not independent; it needs two recordings. The verdict is "
+      "&ldquo;closer&rdquo; or &ldquo;farther&rdquo; only when the interval excludes "
+      "0.</p>\n<table><tr><th class=\"name\">variant</th>" +
+      std::string(kPairedHeader) + "</tr>\n";
+  for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
+    html += "<tr>" + cell(escape(comparison.variants[v].name), "name") +
+            paired_cells(comparison, v) + "</tr>\n";
+  }
+  return html + "</table>\n";
+}
+
+std::string conditions_section(const Comparison& comparison) {
+  const auto conditions = conditions_of(comparison);
+  if (conditions.empty()) return "";
+  std::string html =
+      "<h2>By condition</h2>\n<p class=\"note\">The figures of the frames in each "
+      "condition: residue cover from the truth mask (1 &minus; its soil fraction), and the "
+      "recordings' tags (recording.json, --tags). The comparison with the baseline is made "
+      "within the condition.</p>\n<table><tr><th class=\"name\">condition</th>"
+      "<th class=\"name\">value</th><th class=\"name\">variant</th><th>frames</th>"
+      "<th>frames valid</th><th>frames missed</th><th>frames false valid</th>"
+      "<th>mean |error| (mm)</th><th>max |error| (mm)</th>"
+      "<th>mean |error| difference (mm)</th><th>95% CI over recordings (mm)</th>"
+      "<th class=\"name\">distance verdict</th></tr>\n";
+  for (const Condition& condition : conditions) {
+    const Comparison part = restricted_to(comparison, condition);
+    for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
+      const Figures f = part.variant_figures(v);
+      const PairedFigures p = paired_figures(part, v);
+      html += "<tr>" + cell(escape(condition.name), "name") +
+              cell(escape(condition.value), "name") +
+              cell(escape(comparison.variants[v].name), "name") + cell(std::to_string(f.frames)) +
+              cell(std::to_string(f.valid)) + count_cell(f.missed) + count_cell(f.false_valid) +
+              cell(fixed(if_any(f.error, f.error.mean_abs_mm))) +
+              cell(fixed(if_any(f.error, f.error.max_abs_mm))) +
+              cell(signed_fixed(p.abs_error_difference_mm)) +
+              cell(interval(p.ci95_low_mm, p.ci95_high_mm)) +
+              verdict_cell(distance_verdict(part, v, p)) + "</tr>\n";
+    }
+  }
+  return html + "</table>\n";
+}
+
+// Who made the report, when and how.
+std::string stamp_paragraph(const json& made) {
+  const auto line_text = [](const json& line) {
+    std::string text;
+    for (const auto& argument : line) {
+      const std::string word = argument.get<std::string>();
+      const bool plain = !word.empty() && word.find_first_of(" \t'\"$\\") == std::string::npos;
+      text += (text.empty() ? "" : " ") + (plain ? word : "'" + word + "'");
+    }
+    return text;
+  };
+  std::string html = "<p class=\"meta stamp\">tilth " +
+                     escape(made["tilth_version"].get<std::string>()) + ", " +
+                     escape(made["date_utc"].get<std::string>()) + ", in " +
+                     escape(made["working_directory"].get<std::string>()) + ": <code>" +
+                     escape(line_text(made["command_line"])) + "</code>";
+  for (const auto& shard : made["shard_command_lines"]) {
+    html += "<br>shard: <code>" + escape(line_text(shard)) + "</code>";
+  }
+  return html + "</p>\n";
+}
+
 std::string recordings_section(const Comparison& comparison) {
   std::string html =
       "<h2>Per recording</h2>\n<table><tr><th class=\"name\">recording</th>"
@@ -157,16 +276,20 @@ std::string stage_times_section(const Comparison& comparison) {
   std::string html =
       "<h2>Time per frame per stage</h2>\n<p class=\"note\">Mean (p99) milliseconds per frame "
       "over every recording, measured while the graphs ran in parallel: compare variants "
-      "with each other, not with a machine running one graph.</p>\n<table><tr>"
+      "with each other, not with a machine running one graph. Times over fewer than " +
+      std::to_string(kMinFramesToTime) +
+      " frames are in parentheses: the first frames' set-up dominates them.</p>\n<table><tr>"
       "<th class=\"name\">variant</th><th class=\"name\">stage</th><th class=\"name\">type</th>"
       "<th>frames</th><th>mean (ms)</th><th>p50 (ms)</th><th>p99 (ms)</th><th>max (ms)</th></tr>\n";
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
     for (const auto& stage : comparison.variant_stage_times(v)) {
+      const bool few = stage.latency.count < kMinFramesToTime;
+      const auto time = [few](double ms) { return few ? "(" + fixed(ms, 3) + ")" : fixed(ms, 3); };
       html += "<tr>" + cell(escape(comparison.variants[v].name), "name") +
               cell(escape(stage.node), "name") + cell(escape(stage.type), "name") +
-              cell(std::to_string(stage.latency.count)) + cell(fixed(stage.latency.mean_ms, 3)) +
-              cell(fixed(stage.latency.p50_ms, 3)) + cell(fixed(stage.latency.p99_ms, 3)) +
-              cell(fixed(stage.latency.max_ms, 3)) + "</tr>\n";
+              cell(std::to_string(stage.latency.count)) + cell(time(stage.latency.mean_ms)) +
+              cell(time(stage.latency.p50_ms)) + cell(time(stage.latency.p99_ms)) +
+              cell(time(stage.latency.max_ms)) + "</tr>\n";
     }
   }
   return html + "</table>\n";
@@ -174,11 +297,13 @@ std::string stage_times_section(const Comparison& comparison) {
 
 std::string overlays_section(const Comparison& comparison, const Overlays& overlays) {
   std::string html =
-      "<h2>Where the variants disagree most</h2>\n<p class=\"key\">"
+      "<h2>Where the variants disagree most</h2>\n<p class=\"note\">Images at the depth "
+      "grid's full resolution: click one to zoom (wheel or +/&minus;, Esc closes).</p>\n"
+      "<p class=\"key\">"
       "<span><i style=\"background:#ffdc00\"></i>residue, called residue</span>"
       "<span><i style=\"background:#e62828\"></i>soil called residue</span>"
-      "<span><i style=\"background:#1e78e6\"></i>residue called soil (reaches the soil "
-      "depth)</span>"
+      "<span><i style=\"background:#ff00ff\"></i>residue called soil (reaches the soil "
+      "depth; painted over the image)</span>"
       "<span><i style=\"background:#a0a0a0\"></i>unknown</span></p>\n";
   for (std::size_t r = 0; r < overlays.size(); ++r) {
     if (overlays[r].empty()) continue;
@@ -253,14 +378,15 @@ std::string report_html(const Comparison& comparison, const json& summary,
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>tilth ab: " +
       escape(names) + "</title>\n<style>\n" + std::string(kReportCss) + "</style>\n</head>\n" +
       "<body data-rendered=\"no\">\n<h1>tilth ab: " + escape(names) + "</h1>\n" +
-      "<p class=\"meta\">" + std::to_string(comparison.variants.size()) + " variants on " +
+      stamp_paragraph(summary["made"]) + "<p class=\"meta\">" +
+      std::to_string(comparison.variants.size()) + " variants on " +
       std::to_string(comparison.recordings.size()) +
       " recordings. Error = measured &minus; true distance, over the frames reported valid that "
       "have a true distance. Missed: a true distance with soil in view, reported invalid. False "
       "valid: less than " +
       threshold +
       " of the truth mask is soil, reported valid. Mask figures count pixels, residue being "
-      "positive. The 95% CI is mean &plusmn; t<sub>0.975, n&minus;1</sub>&middot;s/&radic;n. "
+      "positive. Every 95% CI is mean &plusmn; t<sub>0.975, n&minus;1</sub>&middot;s/&radic;n. "
       "docs/ab-testing.md defines every figure.</p>\n";
   std::string failures;
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
@@ -280,7 +406,8 @@ std::string report_html(const Comparison& comparison, const json& summary,
         "before the failure.</b><ul>\n" +
         failures + "</ul></div>\n";
   }
-  html += variants_section(comparison) + summary_section(comparison);
+  html += variants_section(comparison) + summary_section(comparison) +
+          baseline_section(comparison) + conditions_section(comparison);
   html +=
       "<h2>Distance over time</h2>\n<p class=\"note\">Lines break at frames reported "
       "invalid, which are also marked by ticks at the bottom.</p>\n";

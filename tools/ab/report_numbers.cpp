@@ -1,8 +1,11 @@
 #include "report_numbers.h"
 
 #include <charconv>
+#include <ctime>
 #include <fstream>
 
+#include "conditions.h"
+#include "paired.h"
 #include "tilth/error.h"
 #include "tilth/version.h"
 
@@ -15,39 +18,92 @@ constexpr std::size_t kHistogramBins = 30;
 
 json optional_json(const std::optional<double>& value) { return value ? json(*value) : json(); }
 
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
 json error_json(const ErrorStats& error) {
-  return {{"count", error.count},
-          {"mean_mm", error.count > 0 ? json(error.mean_mm) : json()},
+  const auto if_any = [&](double value) { return error.count > 0 ? json(value) : json(); };
+  return {{"frames_with_error_value", error.count},
+          {"mean_mm", if_any(error.mean_mm)},
           {"std_mm", optional_json(error.std_mm)},
-          {"mean_abs_mm", error.count > 0 ? json(error.mean_abs_mm) : json()},
-          {"max_abs_mm", error.count > 0 ? json(error.max_abs_mm) : json()},
-          {"rms_mm", error.count > 0 ? json(error.rms_mm) : json()},
-          {"ci95_low_mm", optional_json(error.ci95_low_mm)},
-          {"ci95_high_mm", optional_json(error.ci95_high_mm)}};
+          {"mean_abs_mm", if_any(error.mean_abs_mm)},
+          {"max_abs_mm", if_any(error.max_abs_mm)},
+          {"rms_mm", if_any(error.rms_mm)},
+          {"mean_ci95_low_mm", optional_json(error.ci95_low_mm)},
+          {"mean_ci95_high_mm", optional_json(error.ci95_high_mm)}};
 }
 
 json figures_json(const Figures& figures) {
   json mask;
   if (figures.mask) {
-    mask = {{"frames", figures.mask_frames},
-            {"tp", figures.mask->tp},
-            {"fp", figures.mask->fp},
-            {"fn", figures.mask->fn},
-            {"tn", figures.mask->tn},
-            {"unknown", figures.mask->unknown},
-            {"iou", optional_json(figures.mask->iou())},
-            {"precision", optional_json(figures.mask->precision())},
-            {"recall", optional_json(figures.mask->recall())}};
+    const MaskCounts& m = *figures.mask;
+    mask = {{"frames_with_both_masks", figures.mask_frames},
+            {"px_residue_called_residue", m.tp},
+            {"px_soil_called_residue", m.fp},
+            {"px_residue_called_soil_or_unknown", m.fn},
+            {"px_soil_called_soil_or_unknown", m.tn},
+            {"px_called_unknown", m.unknown},
+            {"residue_iou", optional_json(m.iou())},
+            {"residue_precision", optional_json(m.precision())},
+            {"residue_recall", optional_json(m.recall())}};
   }
   return {{"frames", figures.frames},
-          {"measured", figures.measured},
-          {"valid", figures.valid},
-          {"expected_valid", figures.expected_valid},
-          {"no_visible_soil", figures.no_visible_soil},
-          {"missed", figures.missed},
-          {"false_valid", figures.false_valid},
+          {"frames_measured", figures.measured},
+          {"frames_valid", figures.valid},
+          {"frames_expected_valid", figures.expected_valid},
+          {"frames_without_visible_soil", figures.no_visible_soil},
+          {"frames_missed", figures.missed},
+          {"frames_false_valid", figures.false_valid},
           {"error", error_json(figures.error)},
           {"mask", mask}};
+}
+
+json paired_json(const Comparison& comparison, std::size_t variant,
+                 std::optional<std::size_t> recording = std::nullopt) {
+  const PairedFigures paired = paired_figures(comparison, variant, recording);
+  return {{"baseline", comparison.variants[comparison.baseline].name},
+          {"frames_with_both_error_values", paired.frames_with_both_errors},
+          {"recordings", paired.recordings},
+          {"abs_error_difference_mm", optional_json(paired.abs_error_difference_mm)},
+          {"abs_error_difference_ci95_low_mm", optional_json(paired.ci95_low_mm)},
+          {"abs_error_difference_ci95_high_mm", optional_json(paired.ci95_high_mm)},
+          {"verdict", distance_verdict(comparison, variant, paired)},
+          {"frames_missed_by_variant_only", paired.missed_by_variant_only},
+          {"frames_missed_by_baseline_only", paired.missed_by_baseline_only},
+          {"frames_false_valid_by_variant_only", paired.false_valid_by_variant_only},
+          {"frames_false_valid_by_baseline_only", paired.false_valid_by_baseline_only}};
+}
+
+json conditions_json(const Comparison& comparison) {
+  json list = json::array();
+  for (const Condition& condition : conditions_of(comparison)) {
+    const Comparison part = restricted_to(comparison, condition);
+    json by_variant = json::array();
+    for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
+      by_variant.push_back({{"variant", comparison.variants[v].name},
+                            {"figures", figures_json(part.variant_figures(v))},
+                            {"against_baseline", paired_json(part, v)}});
+    }
+    list.push_back(
+        {{"condition", condition.name}, {"value", condition.value}, {"variants", by_variant}});
+  }
+  return list;
+}
+
+json stamp_json(const ReportStamp& stamp) {
+  json shards = json::array();
+  for (const auto& line : stamp.shard_command_lines) shards.push_back(line);
+  return {{"tilth_version", std::string(version())},
+          {"date_utc", utc_now()},
+          {"command_line", stamp.command_line},
+          {"working_directory", stamp.working_directory.string()},
+          {"shard_command_lines", shards}};
 }
 
 std::string setting_text(const NodeSetting& setting) {
@@ -97,14 +153,22 @@ std::string csv_field(const std::string& text) {
   return quoted + "\"";
 }
 
-std::string summary_row(const std::string& variant, const std::string& recording,
-                        const Figures& figures, const std::vector<StageTime>& stages) {
-  double ms_per_frame = 0.0;
-  for (const auto& stage : stages) ms_per_frame += stage.latency.mean_ms;
+constexpr const char* kFigureColumns =
+    "frames,frames_valid,frames_expected_valid,frames_without_visible_soil,frames_missed,"
+    "frames_false_valid,frames_with_error_value,error_mean_mm,error_std_mm,abs_error_mean_mm,"
+    "abs_error_max_mm,error_rms_mm,error_mean_ci95_low_mm,error_mean_ci95_high_mm,"
+    "frames_with_both_masks,residue_iou,residue_precision,residue_recall,baseline,"
+    "frames_with_both_error_values,abs_error_difference_mm,abs_error_difference_ci95_low_mm,"
+    "abs_error_difference_ci95_high_mm,verdict,frames_missed_by_variant_only,"
+    "frames_missed_by_baseline_only";
+
+// The columns of kFigureColumns, each after a comma.
+std::string figure_fields(const Comparison& comparison, std::size_t variant, const Figures& figures,
+                          const PairedFigures& paired) {
   const auto& e = figures.error;
   const auto& m = figures.mask;
   const auto if_any = [&](double value) { return e.count > 0 ? number(value) : ""; };
-  std::string row = csv_field(variant) + "," + csv_field(recording);
+  std::string row;
   for (const std::size_t count :
        {figures.frames, figures.valid, figures.expected_valid, figures.no_visible_soil,
         figures.missed, figures.false_valid, e.count}) {
@@ -115,10 +179,25 @@ std::string summary_row(const std::string& variant, const std::string& recording
         if_any(e.rms_mm), number(e.ci95_low_mm), number(e.ci95_high_mm),
         std::to_string(figures.mask_frames), m ? number(m->iou()) : "",
         m ? number(m->precision()) : "", m ? number(m->recall()) : "",
-        stages.empty() ? "" : number(ms_per_frame)}) {
+        csv_field(comparison.variants[comparison.baseline].name),
+        std::to_string(paired.frames_with_both_errors), number(paired.abs_error_difference_mm),
+        number(paired.ci95_low_mm), number(paired.ci95_high_mm),
+        distance_verdict(comparison, variant, paired),
+        std::to_string(paired.missed_by_variant_only),
+        std::to_string(paired.missed_by_baseline_only)}) {
     row += "," + field;
   }
-  return row + "\n";
+  return row;
+}
+
+std::string summary_row(const Comparison& comparison, std::size_t variant,
+                        const std::string& recording, const Figures& figures,
+                        const PairedFigures& paired, const std::vector<StageTime>& stages) {
+  double ms_per_frame = 0.0;
+  for (const auto& stage : stages) ms_per_frame += stage.latency.mean_ms;
+  return csv_field(comparison.variants[variant].name) + "," + csv_field(recording) +
+         figure_fields(comparison, variant, figures, paired) + "," +
+         (stages.empty() ? "" : number(ms_per_frame)) + "\n";
 }
 
 }  // namespace
@@ -156,7 +235,8 @@ json recordings_json(const std::vector<Recording>& recordings) {
     list.push_back(
         {{"name", recording.name},
          {"path", recording.path.string()},
-         {"format", recording.format == RecordingFormat::kMcap ? "mcap" : "image_folder"}});
+         {"format", recording.format == RecordingFormat::kMcap ? "mcap" : "image_folder"},
+         {"tags", recording.tags}});
   }
   return list;
 }
@@ -169,6 +249,7 @@ json summary_json(const Comparison& comparison, const Overlays& overlays) {
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
     by_variant.push_back({{"variant", comparison.variants[v].name},
                           {"figures", figures_json(comparison.variant_figures(v))},
+                          {"against_baseline", paired_json(comparison, v)},
                           {"stage_times", stage_times_json(comparison.variant_stage_times(v))}});
     for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
       const JobResult& job = comparison.job(v, r);
@@ -177,6 +258,7 @@ json summary_json(const Comparison& comparison, const Overlays& overlays) {
                               {"failed", job.failed},
                               {"failure", job.failure},
                               {"figures", figures_json(comparison.recording_figures(v, r))},
+                              {"against_baseline", paired_json(comparison, v, r)},
                               {"stage_times", stage_times_json(job.stages)},
                               {"frames_per_second", job.frames_per_second}});
     }
@@ -189,30 +271,42 @@ json summary_json(const Comparison& comparison, const Overlays& overlays) {
     }
     disagreements.push_back({{"recording", comparison.recordings[r].name}, {"frames", frames}});
   }
-  return {{"format", "tilth-ab/1"},
+  return {{"format", "tilth-ab/2"},
           {"tilth_version", std::string(version())},
+          {"made", stamp_json(comparison.stamp)},
           {"no_soil_below", comparison.no_soil_below},
           {"variants", variants},
+          {"baseline", comparison.variants[comparison.baseline].name},
           {"recordings", recordings},
           {"variant_figures", by_variant},
           {"recording_figures", by_recording},
+          {"conditions", conditions_json(comparison)},
           {"error_histogram", histogram_json(comparison)},
           {"disagreements", disagreements}};
 }
 
 void write_summary_csv(const Comparison& comparison, const std::filesystem::path& file) {
-  std::string text =
-      "variant,recording,frames,valid,expected_valid,no_visible_soil,missed,false_valid,"
-      "error_count,error_mean_mm,error_std_mm,error_mean_abs_mm,error_max_abs_mm,error_rms_mm,"
-      "error_ci95_low_mm,error_ci95_high_mm,mask_frames,mask_iou,mask_precision,mask_recall,"
-      "ms_per_frame\n";
+  std::string text = "variant,recording," + std::string(kFigureColumns) + ",chain_ms_per_frame\n";
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-    const std::string& name = comparison.variants[v].name;
-    text +=
-        summary_row(name, "*", comparison.variant_figures(v), comparison.variant_stage_times(v));
+    text += summary_row(comparison, v, "*", comparison.variant_figures(v),
+                        paired_figures(comparison, v), comparison.variant_stage_times(v));
     for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
-      text += summary_row(name, comparison.recordings[r].name, comparison.recording_figures(v, r),
+      text += summary_row(comparison, v, comparison.recordings[r].name,
+                          comparison.recording_figures(v, r), paired_figures(comparison, v, r),
                           comparison.job(v, r).stages);
+    }
+  }
+  write_text(file, text);
+}
+
+void write_conditions_csv(const Comparison& comparison, const std::filesystem::path& file) {
+  std::string text = "variant,condition,value," + std::string(kFigureColumns) + "\n";
+  for (const Condition& condition : conditions_of(comparison)) {
+    const Comparison part = restricted_to(comparison, condition);
+    for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
+      text += csv_field(comparison.variants[v].name) + "," + csv_field(condition.name) + "," +
+              csv_field(condition.value) +
+              figure_fields(part, v, part.variant_figures(v), paired_figures(part, v)) + "\n";
     }
   }
   write_text(file, text);

@@ -1,7 +1,8 @@
 // The numbers of a comparison as files: summary.json (everything the report shows),
 // summary.csv (one row per variant and recording, and per variant over all
-// recordings) and frames.csv (one row per variant, recording and frame). Stage times
-// and frame rates are the only numbers that change from run to run.
+// recordings), conditions.csv (one row per variant and condition: residue cover, tags)
+// and frames.csv (one row per variant, recording and frame). Stage times, frame rates
+// and the report's date are the only things that change from run to run.
 #pragma once
 
 #include <filesystem>
@@ -26,6 +27,7 @@ nlohmann::ordered_json recordings_json(const std::vector<Recording>& recordings)
 
 // Throw tilth::Error naming the file when it cannot be written.
 void write_summary_csv(const Comparison& comparison, const std::filesystem::path& file);
+void write_conditions_csv(const Comparison& comparison, const std::filesystem::path& file);
 void write_frames_csv(const Comparison& comparison, const std::filesystem::path& file);
 void write_text(const std::filesystem::path& file, const std::string& text);
 

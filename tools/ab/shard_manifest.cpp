@@ -40,6 +40,7 @@ ordered_json comparison_identity(const Options& options) {
     variables.push_back(variable.key + "=" + variable.value);
   }
   return {{"variants", variants_json(options.variants)},
+          {"baseline", options.variants.at(options.baseline).name},
           {"recordings", recordings_json(options.recordings)},
           {"variables", variables},
           {"no_soil_below", options.no_soil_below},
