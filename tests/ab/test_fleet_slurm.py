@@ -19,6 +19,11 @@ from processes import interrupt, start_logged  # noqa: E402
 from fleet_support import SLURM, TILTH, assert_same_as_single_run, fleet_environment  # noqa: E402
 
 SHARDS = 3
+ATTEMPTS = 3
+
+
+class PortTaken(RuntimeError):
+    pass
 TIMEOUT = 120  # seconds for the array and the merge to end
 
 
@@ -39,13 +44,20 @@ def tail(path, lines=30):
 class SlurmClusterTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.folder = tempfile.mkdtemp(prefix="tilth-fleet-slurm-")
-        cls.daemons = []
-        try:
-            cls.start_cluster()
-        except BaseException:
-            cls.tearDownClass()
-            raise
+        # The daemons' ports are free when chosen but another test may take one before a
+        # daemon binds it: then the cluster starts again on other ports.
+        for attempt in range(ATTEMPTS):
+            cls.folder = tempfile.mkdtemp(prefix="tilth-fleet-slurm-")
+            cls.daemons = []
+            try:
+                cls.start_cluster()
+                return
+            except PortTaken:
+                cls.tearDownClass()
+            except BaseException:
+                cls.tearDownClass()
+                raise
+        raise RuntimeError("the cluster's ports were taken %d times over" % ATTEMPTS)
 
     @classmethod
     def start_cluster(cls):
@@ -106,7 +118,11 @@ class SlurmClusterTest(unittest.TestCase):
         while not condition():
             for daemon in cls.daemons:
                 if daemon.poll() is not None:
-                    raise RuntimeError("%s exited (%d) waiting for %s:\n%s" % (
+                    logs = [os.path.join(cls.folder, "log", name)
+                            for name in ("slurmctld.log", "slurmd.log")]
+                    taken = any("Address already in use" in tail(path) for path in logs)
+                    problem = PortTaken if taken else RuntimeError
+                    raise problem("%s exited (%d) waiting for %s:\n%s" % (
                         daemon.args, daemon.returncode, what, tail(log)))
             if time.monotonic() > deadline:
                 raise RuntimeError("no %s after %d s:\n%s" % (what, seconds, tail(log)))

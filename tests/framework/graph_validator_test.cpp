@@ -138,7 +138,7 @@ TEST_F(GraphValidatorTest, ParametersAreChecked) {
                  "edges": [["src.out", "out.in"], ["src.out", "p.in"]]})"),
       at("/nodes/src/params/cont") +
           ": unknown parameter 'cont' of test.counter; did you mean 'count'? (its parameters: "
-          "'count', 'period_us', 'step')\n" +
+          "'count', 'period_us', 'start_delay_us', 'step')\n" +
           at("/nodes/src/params/period_us") +
           ": parameter 'period_us': expected an integer >= 0, got -1\n" +
           at("/nodes/out/params/delay_us") +
