@@ -2,25 +2,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mcap/json_time.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 
 namespace tilth::mcap {
-namespace {
 
 using nlohmann::json;
-
-constexpr std::int64_t kNsPerSecond = 1'000'000'000;
-
-json time_schema() {
-  return {{"type", "object"},
-          {"title", "time"},
-          {"properties",
-           {{"sec", {{"type", "integer"}, {"minimum", 0}}},
-            {"nsec", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999999}}}}}};
-}
-
-}  // namespace
 
 std::string ground_truth_schema() {
   const json schema = {
@@ -39,11 +27,10 @@ std::string ground_truth_schema() {
 
 std::string encode_ground_truth(std::optional<double> distance_mm, bool has_mask,
                                 std::int64_t timestamp_ns) {
-  json message = {
-      {"timestamp", {{"sec", timestamp_ns / kNsPerSecond}, {"nsec", timestamp_ns % kNsPerSecond}}},
-      {"frame_id", "tof"},
-      {"distance_mm", nullptr},
-      {"has_mask", has_mask}};
+  json message = {{"timestamp", time_json(timestamp_ns)},
+                  {"frame_id", "tof"},
+                  {"distance_mm", nullptr},
+                  {"has_mask", has_mask}};
   if (distance_mm) message["distance_mm"] = *distance_mm;
   return message.dump();
 }

@@ -11,6 +11,15 @@ inline constexpr std::string_view kRawTopic = "/tof/raw";        // RawImage mon
 inline constexpr std::string_view kColorTopic = "/color/image";  // bgr8, rgb8 or bayer_*8
 inline constexpr std::string_view kTruthTopic = "/truth";        // tilth.GroundTruth
 inline constexpr std::string_view kMaskTopic = "/truth/mask";    // RawImage mono8
+// What the chain measured, when the graph gives it to the writer.
+inline constexpr std::string_view kDistanceTopic = "/tilth/distance";  // tilth.GroundDistance
+inline constexpr std::string_view kResidueMaskTopic = "/tilth/mask";   // RawImage mono8
+inline constexpr std::string_view kRegisteredColorTopic = "/tilth/registered_color";  // bgr8
+inline constexpr std::string_view kCameraStatusTopic = "/tilth/cameras";  // tilth.CameraStatus
+// The rig, once, with the first frame.
+inline constexpr std::string_view kTofCalibrationTopic = "/tof/calibration";
+inline constexpr std::string_view kColorCalibrationTopic = "/color/calibration";
+inline constexpr std::string_view kTransformTopic = "/tf";  // foxglove.FrameTransform
 
 inline constexpr std::string_view kCalibrationAttachment = "rig.calib.json";
 inline constexpr std::string_view kCalibrationMetadata = "tilth.calibration";  // key "json"

@@ -1,9 +1,15 @@
 // mcap.writer: records raw ToF frames, colour images and ground truth as an MCAP file
-// that mcap.player replays and Foxglove opens as it is.
+// that mcap.player replays and Foxglove opens as it is, and beside them, when the graph
+// gives them, what the chain measured: the distance, the residue mask, the registered
+// colour and the cameras' health.
 //
-//   raw ──┐
-//   color ├─> mcap.writer ──> FILE.mcap: /tof/raw, /color/image, /truth, /truth/mask
-//   truth ┘   (optional)
+//   raw ──────────┐
+//   color ────────┤
+//   truth ────────┤             FILE.mcap: /tof/raw, /color/image, /truth, /truth/mask,
+//   distance ─────┼─> mcap.writer ──> /tilth/distance, /tilth/mask, /tilth/registered_color,
+//   mask ─────────┤             /tilth/cameras; the rig once: /tof/calibration,
+//   registered ───┤             /color/calibration, /tf
+//   cameras ──────┘  (all but raw and color optional)
 //
 // Invariant: a frame's messages are never split across chunks (a chunk is closed only
 // between frames), so a file cut off mid-write loses whole frames, never half of one.
@@ -19,17 +25,23 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include "mcap/ground_truth_message.h"
 #include "mcap/mcap_writer.h"
+#include "mcap/measurement_messages.h"
 #include "mcap/raw_image.h"
 #include "mcap/recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
+#include "tilth/messages/camera_status.h"
 #include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_distance.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/messages/registered_color.h"
+#include "tilth/messages/residue_mask.h"
 #include "tilth/plugin.h"
 #include "tilth/version.h"
 
@@ -38,9 +50,29 @@ namespace {
 
 namespace fs = std::filesystem;
 
+const std::string kCdr(kCdrEncoding);
+
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
+constexpr std::size_t kDistancePort = 3;
+constexpr std::size_t kMaskPort = 4;
+constexpr std::size_t kRegisteredPort = 5;
+constexpr std::size_t kCamerasPort = 6;
+
+// A frame's optional inputs, null where the graph gave none.
+struct Measured {
+  const GroundDistance* distance = nullptr;
+  const ResidueMask* mask = nullptr;
+  const RegisteredColor* registered = nullptr;
+  const CameraStatus* cameras = nullptr;
+};
+
+template <class T>
+const T* optional_input(const Frame& frame, std::size_t port) {
+  const Packet& packet = frame.input(port);
+  return packet.empty() ? nullptr : &packet.get<T>();
+}
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -123,11 +155,22 @@ class McapWriterStage final : public Sink {
     truth_channel_ =
         writer_.add_channel(truth, std::string(kTruthTopic), std::string(kJsonEncoding));
     mask_channel_ = writer_.add_channel(image, std::string(kMaskTopic), cdr);
+    const std::uint16_t calibration =
+        json_schema(kCameraCalibrationSchemaName, camera_calibration_schema());
+    tof_calibration_channel_ = json_channel(calibration, kTofCalibrationTopic);
+    color_calibration_channel_ = json_channel(calibration, kColorCalibrationTopic);
+    transform_channel_ = json_channel(
+        json_schema(kFrameTransformSchemaName, frame_transform_schema()), kTransformTopic);
+    image_schema_ = image;
   }
 
   void consume(const Frame& frame) override {
     const auto& raw = frame.input<RawTofFrame>(kRawPort);
     const auto& color = frame.input<ColorImage>(kColorPort);
+    const Measured measured{optional_input<GroundDistance>(frame, kDistancePort),
+                            optional_input<ResidueMask>(frame, kMaskPort),
+                            optional_input<RegisteredColor>(frame, kRegisteredPort),
+                            optional_input<CameraStatus>(frame, kCamerasPort)};
     const Packet& truth_packet = frame.input(kTruthPort);
     const GroundTruth* truth = truth_packet.empty() ? nullptr : &truth_packet.get<GroundTruth>();
     // A truth that knows nothing (a replayed recording without any) is not recorded.
@@ -143,6 +186,10 @@ class McapWriterStage final : public Sink {
     check_image("color", color.pixels, CV_8UC(channels(color.format)), color_size_);
     const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
     if (has_mask) check_image("truth mask", truth->residue_mask, CV_8UC1, depth_size_);
+    if (measured.mask != nullptr) check_image("mask", measured.mask->values, CV_8UC1, depth_size_);
+    if (measured.registered != nullptr) {
+      check_image("registered", measured.registered->bgr, CV_8UC3, depth_size_);
+    }
     const std::uint64_t raw_time = device_time("raw", raw.device_timestamp_ns);
     const std::uint64_t color_time = device_time("color", color.device_timestamp_ns);
     // Log times: the frame's host capture time for every message, or each image's device time.
@@ -158,7 +205,7 @@ class McapWriterStage final : public Sink {
       return;
     }
     try {
-      write_frame(raw, color, truth, sequence, raw_log_time, color_log_time);
+      write_frame(raw, color, truth, measured, sequence, raw_log_time, color_log_time);
     } catch (const Error& error) {
       stop_recording(error.what());
     }
@@ -180,24 +227,68 @@ class McapWriterStage final : public Sink {
 
  private:
   void write_frame(const RawTofFrame& raw, const ColorImage& color, const GroundTruth* truth,
-                   std::uint32_t sequence, std::uint64_t raw_log_time,
+                   const Measured& measured, std::uint32_t sequence, std::uint64_t raw_log_time,
                    std::uint64_t color_log_time) {
     const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
-    writer_.write(raw_channel_, sequence, raw_log_time, raw_log_time,
-                  encode_raw_image(raw.gray, "mono16", raw.device_timestamp_ns, kTofFrameId));
-    writer_.write(color_channel_, sequence, color_log_time, color_log_time,
-                  encode_raw_image(color.pixels, to_string(color.format), color.device_timestamp_ns,
-                                   kColorFrameId));
+    const std::int64_t time = raw.device_timestamp_ns;
+    // Channels of what the chain measured are added with the first frame that has it,
+    // before any of that frame's messages: chunks still close only between frames.
+    if (measured.distance != nullptr && !distance_channel_) {
+      distance_channel_ = json_channel(
+          json_schema(kGroundDistanceSchemaName, ground_distance_schema()), kDistanceTopic);
+    }
+    if (measured.cameras != nullptr && !cameras_channel_) {
+      cameras_channel_ = json_channel(json_schema(kCameraStatusSchemaName, camera_status_schema()),
+                                      kCameraStatusTopic);
+    }
+    if (measured.mask != nullptr && !residue_mask_channel_) {
+      residue_mask_channel_ =
+          writer_.add_channel(image_schema_, std::string(kResidueMaskTopic), kCdr);
+    }
+    if (measured.registered != nullptr && !registered_channel_) {
+      registered_channel_ =
+          writer_.add_channel(image_schema_, std::string(kRegisteredColorTopic), kCdr);
+    }
+    std::uint64_t messages = 0;
+    const auto put = [&](std::uint16_t channel, std::uint64_t log_time, std::string_view data) {
+      writer_.write(channel, sequence, log_time, log_time, data);
+      ++messages;
+    };
+    if (!rig_written_) {
+      put(tof_calibration_channel_, raw_log_time,
+          encode_camera_calibration(calibration_.depth, kTofFrameId, time));
+      put(color_calibration_channel_, raw_log_time,
+          encode_camera_calibration(calibration_.color, kColorFrameId, time));
+      put(transform_channel_, raw_log_time,
+          encode_color_pose(calibration_, kTofFrameId, kColorFrameId, time));
+      rig_written_ = true;
+    }
+    put(raw_channel_, raw_log_time, encode_raw_image(raw.gray, "mono16", time, kTofFrameId));
+    put(color_channel_, color_log_time,
+        encode_raw_image(color.pixels, to_string(color.format), color.device_timestamp_ns,
+                         kColorFrameId));
     if (truth != nullptr) {
-      writer_.write(truth_channel_, sequence, raw_log_time, raw_log_time,
-                    encode_ground_truth(truth->distance_mm, has_mask, raw.device_timestamp_ns));
+      put(truth_channel_, raw_log_time, encode_ground_truth(truth->distance_mm, has_mask, time));
       if (has_mask) {
-        writer_.write(
-            mask_channel_, sequence, raw_log_time, raw_log_time,
-            encode_raw_image(truth->residue_mask, "mono8", raw.device_timestamp_ns, kTofFrameId));
+        put(mask_channel_, raw_log_time,
+            encode_raw_image(truth->residue_mask, "mono8", time, kTofFrameId));
       }
     }
-    messages_given_ += 2 + (truth != nullptr ? 1 : 0) + (has_mask ? 1 : 0);
+    if (measured.distance != nullptr) {
+      put(*distance_channel_, raw_log_time, encode_ground_distance(*measured.distance, time));
+    }
+    if (measured.mask != nullptr) {
+      put(*residue_mask_channel_, raw_log_time,
+          encode_raw_image(measured.mask->values, "mono8", time, kTofFrameId));
+    }
+    if (measured.registered != nullptr) {
+      put(*registered_channel_, raw_log_time,
+          encode_raw_image(measured.registered->bgr, "bgr8", time, kTofFrameId));
+    }
+    if (measured.cameras != nullptr) {
+      put(*cameras_channel_, raw_log_time, encode_camera_status(*measured.cameras, time));
+    }
+    messages_given_ += messages;
     frame_ends_.push_back(messages_given_);
     writer_.close_chunk_if_full();
     count_stored_frames();
@@ -209,6 +300,14 @@ class McapWriterStage final : public Sink {
       frame_ends_.pop_front();
       ++frames_stored_;
     }
+  }
+
+  std::uint16_t json_schema(std::string_view name, const std::string& schema) {
+    return writer_.add_schema(std::string(name), std::string(kJsonSchemaEncoding), schema);
+  }
+
+  std::uint16_t json_channel(std::uint16_t schema, std::string_view topic) {
+    return writer_.add_channel(schema, std::string(topic), std::string(kJsonEncoding));
   }
 
   void stop_recording(const std::string& why) {
@@ -238,16 +337,31 @@ class McapWriterStage final : public Sink {
   std::uint16_t color_channel_ = 0;
   std::uint16_t truth_channel_ = 0;
   std::uint16_t mask_channel_ = 0;
+  std::uint16_t image_schema_ = 0;
+  std::uint16_t tof_calibration_channel_ = 0;
+  std::uint16_t color_calibration_channel_ = 0;
+  std::uint16_t transform_channel_ = 0;
+  bool rig_written_ = false;  // the calibrations and the pose, with the first frame
+  std::optional<std::uint16_t> distance_channel_;
+  std::optional<std::uint16_t> residue_mask_channel_;
+  std::optional<std::uint16_t> registered_channel_;
+  std::optional<std::uint16_t> cameras_channel_;
 };
 
 StageDescriptor describe() {
   StageDescriptor d;
   d.type = "mcap.writer";
-  d.summary = "records raw ToF, colour and ground truth as an MCAP file (Foxglove RawImage)";
+  d.summary =
+      "records raw ToF, colour, ground truth and what the chain measured as an MCAP file "
+      "(Foxglove RawImage, CameraCalibration, FrameTransform; the distance as JSON)";
   d.inputs = {
       PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
       PortSpec::of<ColorImage>("color", "bgr8, rgb8, mono8 or a Bayer mosaic"),
       PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
+      PortSpec::of<GroundDistance>("distance", "the distance the chain measured").optional(),
+      PortSpec::of<ResidueMask>("mask", "the chain's residue mask, in the depth grid").optional(),
+      PortSpec::of<RegisteredColor>("registered", "the colour on the depth grid").optional(),
+      PortSpec::of<CameraStatus>("cameras", "the cameras' health").optional(),
   };
   d.params = {
       ParamSpec::path("path", std::nullopt)

@@ -15,6 +15,8 @@
 #include "mcap/mcap_recording.h"
 #include "mcap/raw_image.h"
 #include "mcap_fixture.h"
+#include "tilth/messages/camera_status.h"
+#include "tilth/messages/ground_distance.h"
 #include "tilth/version.h"
 
 namespace tilth::testing {
@@ -36,13 +38,28 @@ class McapStagesTest : public McapTest {
     return messages;
   }
 
-  // The image timestamp of a RawImage message, or the `timestamp` of a /truth message.
+  // The image timestamp of a RawImage message, or the `timestamp` of a JSON message.
   static std::int64_t stamp_of(const std::string& topic, const mcap::Message& message) {
-    if (topic == "/truth") {
+    if (message.data.starts_with("{")) {
       const json stamp = json::parse(message.data)["timestamp"];
       return stamp["sec"].get<std::int64_t>() * 1'000'000'000 + stamp["nsec"].get<std::int64_t>();
     }
     return mcap::decode_raw_image(message.data, topic).timestamp_ns;
+  }
+
+  // An mcap.writer that a test hands frames to itself, one chunk per frame.
+  StageInstance direct_writer(const fs::path& file) {
+    StageContext context{"w",
+                         Params(json{{"path", file.string()},
+                                     {"compression", "zstd"},
+                                     {"when_behind", "wait"},
+                                     {"log_time", "host"},
+                                     {"chunk_size", 1},
+                                     {"calibration", calibration_file_.string()},
+                                     {"graph_file", ""}}),
+                         Logger("w"),
+                         {}};
+    return registry_.create("mcap.writer", context);
   }
 
   // Null when no frame has the id.
@@ -129,10 +146,15 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   std::map<std::string, std::uint64_t> counts;
   for (const auto& [id, channel] : reader.channels()) {
     const mcap::Schema& schema = reader.schemas().at(channel.schema_id);
-    if (channel.topic == "/truth") {
+    const std::map<std::string, std::string> json_schemas{
+        {"/truth", "tilth.GroundTruth"},
+        {"/tof/calibration", "foxglove.CameraCalibration"},
+        {"/color/calibration", "foxglove.CameraCalibration"},
+        {"/tf", "foxglove.FrameTransform"}};
+    if (const auto found = json_schemas.find(channel.topic); found != json_schemas.end()) {
       EXPECT_EQ(channel.message_encoding, "json");
       EXPECT_EQ(schema.encoding, "jsonschema");
-      EXPECT_EQ(schema.name, "tilth.GroundTruth");
+      EXPECT_EQ(schema.name, found->second);
     } else {
       EXPECT_EQ(channel.message_encoding, "cdr");
       EXPECT_EQ(schema.encoding, "ros2msg");
@@ -140,9 +162,11 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
     }
     counts[channel.topic] = reader.statistics()->channel_message_counts.at(id);
   }
-  // Frames without truth (every second one) have no /truth message.
+  // Frames without truth (every second one) have no /truth message; the rig is recorded
+  // once, with the first frame.
   const std::map<std::string, std::uint64_t> expected_counts{
-      {"/tof/raw", 4}, {"/color/image", 4}, {"/truth", 2}, {"/truth/mask", 2}};
+      {"/tof/raw", 4},         {"/color/image", 4},       {"/truth", 2}, {"/truth/mask", 2},
+      {"/tof/calibration", 1}, {"/color/calibration", 1}, {"/tf", 1}};
   EXPECT_EQ(counts, expected_counts);
   EXPECT_EQ(reader.chunks().size(), 4u);  // chunk_size 1: one frame per chunk
   // Log times are host capture times.
@@ -162,8 +186,8 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
 
   // The first colour message: a RawImage in CDR, byte by byte where it is not pixels.
   const std::vector<mcap::Message> messages = reader.read_chunk(reader.chunks().front());
-  ASSERT_EQ(messages.size(), 4u);  // raw, color, truth, mask
-  const std::string& cdr = messages[1].data;
+  ASSERT_EQ(messages.size(), 7u);  // the rig's 3, raw, color, truth, mask
+  const std::string& cdr = messages[4].data;
   const std::string head(
       "\x00\x01\x00\x00"                  // CDR, little-endian
       "\x01\x00\x00\x00\x80\x1a\x06\x00"  // timestamp 1 s 400000 ns
@@ -181,19 +205,19 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
   EXPECT_EQ(cdr.substr(0, head.size()), head);
   EXPECT_EQ(cdr.substr(head.size()),
             std::string(reinterpret_cast<const char*>(frames_[0].color.data), 3600));
-  EXPECT_EQ(messages[1].sequence, 3u);
-  EXPECT_EQ(messages[1].log_time, 1'763'800'000'002'000'000u);
-  EXPECT_EQ(messages[1].publish_time, 1'763'800'000'002'000'000u);
+  EXPECT_EQ(messages[4].sequence, 3u);
+  EXPECT_EQ(messages[4].log_time, 1'763'800'000'002'000'000u);
+  EXPECT_EQ(messages[4].publish_time, 1'763'800'000'002'000'000u);
   const mcap::RawImage color = mcap::decode_raw_image(cdr, "test");
   EXPECT_EQ(color.encoding, "bgr8");
   EXPECT_EQ(color.frame_id, "color");
   EXPECT_EQ(color.timestamp_ns, 1'000'400'000);
   EXPECT_TRUE(same_pixels(frames_[0].color, color.pixels));
-  EXPECT_EQ(json::parse(messages[2].data)["distance_mm"], 500.0);
+  EXPECT_EQ(json::parse(messages[5].data)["distance_mm"], 500.0);
 
   const mcap::RecordingInfo info = mcap::recording_info(file);
   EXPECT_TRUE(info.has_summary);
-  EXPECT_EQ(info.message_count, 12u);
+  EXPECT_EQ(info.message_count, 15u);
   EXPECT_EQ(info.chunk_count, 4u);
   EXPECT_DOUBLE_EQ(info.duration_s(), 0.3);
   EXPECT_NE(
@@ -270,7 +294,8 @@ TEST_F(McapStagesTest, LogTimesAreHostCaptureTimesAndImageStampsDeviceTimes) {
   const fs::path file = dir_.path() / "times.mcap";
   ASSERT_FALSE(record(file, PixelFormat::kBgr8).failed);
   const auto messages = messages_of(file);
-  ASSERT_EQ(messages.size(), 10u);  // 3 frames of raw and colour, 2 of truth and mask
+  // 3 frames of raw and colour, 2 of truth and mask, the rig's 3 with the first frame
+  ASSERT_EQ(messages.size(), 13u);
   for (const auto& [topic, message] : messages) {
     SCOPED_TRACE(topic + " frame " + std::to_string(message.sequence));
     const TestFrame* frame = frame_with_id(message.sequence);
@@ -304,17 +329,7 @@ TEST_F(McapStagesTest, DeviceLogTimesPlayAsHostTimes) {
 TEST_F(McapStagesTest, AFrameWithoutHostTimeIsLoggedAtItsDeviceTime) {
   frames_ = make_frames(2, small_calibration(), 3);
   const fs::path file = dir_.path() / "unknown-host.mcap";
-  StageContext context{"w",
-                       Params(json{{"path", file.string()},
-                                   {"compression", "zstd"},
-                                   {"when_behind", "wait"},
-                                   {"log_time", "host"},
-                                   {"chunk_size", 1},
-                                   {"calibration", calibration_file_.string()},
-                                   {"graph_file", ""}}),
-                       Logger("w"),
-                       {}};
-  StageInstance writer = registry_.create("mcap.writer", context);
+  StageInstance writer = direct_writer(file);
   auto& sink = dynamic_cast<Sink&>(*writer.stage);
   const auto consume = [&](const TestFrame& frame, std::int64_t host_timestamp_ns) {
     const FrameInfo info{0, frame.index, frame.depth_timestamp_ns, host_timestamp_ns};
@@ -325,7 +340,12 @@ TEST_F(McapStagesTest, AFrameWithoutHostTimeIsLoggedAtItsDeviceTime) {
     color.pixels = frame.color;
     color.device_timestamp_ns = frame.color_timestamp_ns;
     const std::vector<Packet> inputs{Packet(info, std::make_shared<RawTofFrame>(raw)),
-                                     Packet(info, std::make_shared<ColorImage>(color)), Packet()};
+                                     Packet(info, std::make_shared<ColorImage>(color)),
+                                     Packet(),
+                                     Packet(),
+                                     Packet(),
+                                     Packet(),
+                                     Packet()};
     sink.consume(Frame(info, inputs, {}));
   };
   consume(frames_[0], 0);
@@ -337,9 +357,72 @@ TEST_F(McapStagesTest, AFrameWithoutHostTimeIsLoggedAtItsDeviceTime) {
   }
   sink.finish();
   const auto messages = messages_of(file);
-  ASSERT_EQ(messages.size(), 2u);
+  ASSERT_EQ(messages.size(), 5u);  // the rig's 3, raw and colour
   for (const auto& [topic, message] : messages) {
     EXPECT_EQ(message.log_time, 1'000'000'000u) << topic;
+  }
+}
+
+// An invalid distance is recorded with its cause and no number, and the cameras' health
+// beside it; both at the frame's log time, stamped with its depth device time.
+TEST_F(McapStagesTest, RecordsTheDistanceAndTheCamerasHealthAsJson) {
+  frames_ = make_frames(1, small_calibration(), 3);
+  const fs::path file = dir_.path() / "measured.mcap";
+  StageInstance writer = direct_writer(file);
+  auto& sink = dynamic_cast<Sink&>(*writer.stage);
+  const TestFrame& frame = frames_[0];
+  const FrameInfo info{0, frame.index, frame.depth_timestamp_ns, 1'763'800'000'000'000'000};
+  auto raw = std::make_shared<RawTofFrame>();
+  raw->gray = frame.depth;
+  raw->device_timestamp_ns = frame.depth_timestamp_ns;
+  auto color = std::make_shared<ColorImage>();
+  color->pixels = frame.color;
+  color->device_timestamp_ns = frame.color_timestamp_ns;
+  auto distance = std::make_shared<GroundDistance>();
+  distance->distance_mm = 512.5;
+  distance->soil_fraction = 0.004;
+  distance->invalidate(InvalidCause::kTooLittleSoil, "0.4 % of the region is soil < 5 %");
+  auto cameras = std::make_shared<CameraStatus>();
+  cameras->camera = "depth+color";
+  cameras->problem = "depth: no frame for 2.0 s";
+  cameras->completed = 41;
+  cameras->lost = 3;
+  const std::vector<Packet> inputs{
+      Packet(info, raw), Packet(info, color),  Packet(), Packet(info, distance), Packet(),
+      Packet(),          Packet(info, cameras)};
+  sink.consume(Frame(info, inputs, {}));
+  sink.finish();
+
+  std::map<std::string, json> recorded;
+  for (const auto& [topic, message] : messages_of(file)) {
+    if (topic == "/tilth/distance" || topic == "/tilth/cameras") {
+      EXPECT_EQ(message.log_time, 1'763'800'000'000'000'000u) << topic;
+      EXPECT_EQ(stamp_of(topic, message), frame.depth_timestamp_ns) << topic;
+      recorded[topic] = json::parse(message.data);
+    }
+  }
+  ASSERT_EQ(recorded.size(), 2u);
+  const json& d = recorded["/tilth/distance"];
+  EXPECT_TRUE(d["distance_mm"].is_null());
+  EXPECT_EQ(d["valid"], false);
+  EXPECT_EQ(d["invalid_cause"], "too_little_soil");
+  EXPECT_EQ(d["invalid_reason"], "0.4 % of the region is soil < 5 %");
+  EXPECT_EQ(d["soil_fraction"], 0.004);
+  EXPECT_TRUE(d["tilt_x_deg"].is_null());
+  const json& c = recorded["/tilth/cameras"];
+  EXPECT_EQ(c["camera"], "depth+color");
+  EXPECT_EQ(c["streaming"], false);
+  EXPECT_EQ(c["problem"], "depth: no frame for 2.0 s");
+  EXPECT_EQ(c["completed"], 41);
+  EXPECT_EQ(c["lost"], 3);
+  mcap::McapReader reader(file);
+  for (const auto& [id, channel] : reader.channels()) {
+    if (channel.topic == "/tilth/distance") {
+      EXPECT_EQ(reader.schemas().at(channel.schema_id).name, "tilth.GroundDistance");
+    }
+    if (channel.topic == "/tilth/cameras") {
+      EXPECT_EQ(reader.schemas().at(channel.schema_id).name, "tilth.CameraStatus");
+    }
   }
 }
 

@@ -10,6 +10,11 @@ export function paperRigPath() {
   return path.join(SOURCE, "calib", "paper_rig.calib.json");
 }
 
+// calib/field_rig.calib.json: another rig, its colour camera rotated and offset.
+export function fieldRigPath() {
+  return path.join(SOURCE, "calib", "field_rig.calib.json");
+}
+
 // The paper's rig at a quarter of its resolution, the same fields of view, written into
 // `folder`; returns its path.
 export function quarterRig(folder) {

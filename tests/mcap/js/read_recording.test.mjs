@@ -63,18 +63,24 @@ const openReader = () => openMcap(file);
 test("channels, schemas and message counts", async () => {
   const reader = await openReader();
   const topics = [...reader.channelsById.values()].map((channel) => channel.topic).sort();
-  assert.deepEqual(topics, ["/color/image", "/tof/raw", "/truth", "/truth/mask"]);
+  assert.deepEqual(topics, ["/color/calibration", "/color/image", "/tf", "/tof/calibration",
+                            "/tof/raw", "/truth", "/truth/mask"]);
+  // JSON messages; the images are RawImages. The rig (calibrations, pose) comes once.
+  const json = { "/truth": "tilth.GroundTruth", "/tof/calibration": "foxglove.CameraCalibration",
+                 "/color/calibration": "foxglove.CameraCalibration",
+                 "/tf": "foxglove.FrameTransform" };
   for (const channel of reader.channelsById.values()) {
     const schema = reader.schemasById.get(channel.schemaId);
-    const truth = channel.topic === "/truth";
-    assert.equal(channel.messageEncoding, truth ? "json" : "cdr");
-    assert.equal(schema.encoding, truth ? "jsonschema" : "ros2msg");
-    assert.equal(schema.name, truth ? "tilth.GroundTruth" : "foxglove_msgs/msg/RawImage");
+    const name = json[channel.topic];
+    assert.equal(channel.messageEncoding, name ? "json" : "cdr");
+    assert.equal(schema.encoding, name ? "jsonschema" : "ros2msg");
+    assert.equal(schema.name, name ?? "foxglove_msgs/msg/RawImage");
     decoderFor(reader, channel.id);  // the schema parses
     const count = reader.statistics.channelMessageCounts.get(channel.id);
-    assert.equal(count, BigInt(FRAMES), channel.topic);
+    const rig = ["/tof/calibration", "/color/calibration", "/tf"].includes(channel.topic);
+    assert.equal(count, BigInt(rig ? 1 : FRAMES), channel.topic);
   }
-  assert.equal(reader.statistics.messageCount, BigInt(4 * FRAMES));
+  assert.equal(reader.statistics.messageCount, BigInt(4 * FRAMES + 3));
   assert.ok(reader.chunkIndexes.length >= 1);
   assert.ok(reader.chunkIndexes.every((chunk) => chunk.compression === "zstd"));
 });
@@ -154,7 +160,7 @@ test("the stream reader reads every record with valid CRCs", () => {
   let record;
   while ((record = stream.nextRecord())) counts[record.type] = (counts[record.type] ?? 0) + 1;
   assert.ok(stream.done());
-  assert.equal(counts.Message, 4 * FRAMES);
+  assert.equal(counts.Message, 4 * FRAMES + 3);
   assert.equal(counts.Footer, 1);
   assert.equal(counts.DataEnd, 1);
 });
