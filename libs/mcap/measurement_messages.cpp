@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "mcap/json_time.h"
+#include "tilth/error.h"
+#include "tilth/json_input.h"
 
 namespace tilth::mcap {
 namespace {
@@ -140,6 +142,41 @@ std::string encode_ground_distance(const GroundDistance& distance, std::int64_t 
               {"held", distance.held},
               {"held_ms", distance.held_ms}}
       .dump();
+}
+
+GroundDistance decode_ground_distance(std::string_view text, const std::string& where) {
+  const json message = parse_json(text, where);
+  if (!message.is_object()) throw Error(where + ": message data is not a JSON object");
+  try {
+    GroundDistance distance;
+    const std::string cause = message.at("invalid_cause").get<std::string>();
+    for (auto code = static_cast<std::uint8_t>(InvalidCause::kNone);
+         code <= static_cast<std::uint8_t>(InvalidCause::kImageUnusable); ++code) {
+      if (to_string(static_cast<InvalidCause>(code)) == cause) {
+        distance.cause = static_cast<InvalidCause>(code);
+      }
+    }
+    if (to_string(distance.cause) != cause) {
+      throw Error(where + ": unknown invalid_cause '" + cause + "'");
+    }
+    distance.valid = message.at("valid").get<bool>();
+    const json& value = message.at("distance_mm");
+    if (distance.valid) distance.distance_mm = value.get<double>();
+    distance.invalid_reason = message.at("invalid_reason").get<std::string>();
+    distance.soil_fraction = message.at("soil_fraction").get<double>();
+    distance.soil_pixels = message.at("soil_pixels").get<std::int64_t>();
+    distance.spread_mm = message.at("spread_mm").get<double>();
+    distance.confidence = message.at("confidence").get<double>();
+    for (const auto& [key, tilt] : {std::pair{"tilt_x_deg", &distance.tilt_x_deg},
+                                    std::pair{"tilt_y_deg", &distance.tilt_y_deg}}) {
+      if (!message.at(key).is_null()) *tilt = message.at(key).get<double>();
+    }
+    distance.held = message.at("held").get<bool>();
+    distance.held_ms = message.at("held_ms").get<double>();
+    return distance;
+  } catch (const json::exception& error) {
+    throw Error(where + ": not a tilth.GroundDistance: " + error.what());
+  }
 }
 
 std::string encode_camera_status(const CameraStatus& status, std::int64_t timestamp_ns) {

@@ -27,6 +27,8 @@ std::string frame_transform_schema();
 
 // `timestamp_ns`: the frame's depth device time, as its images'.
 std::string encode_ground_distance(const GroundDistance& distance, std::int64_t timestamp_ns);
+// Throws tilth::Error naming `where` for a message that is not a tilth.GroundDistance.
+GroundDistance decode_ground_distance(std::string_view json, const std::string& where);
 std::string encode_camera_status(const CameraStatus& status, std::int64_t timestamp_ns);
 // A pinhole camera with OpenCV's k1, k2, p1, p2, k3 ("plumb_bob"), unrectified.
 std::string encode_camera_calibration(const CameraIntrinsics& camera, std::string_view frame_id,

@@ -1,7 +1,8 @@
 // mcap.player: replays an MCAP recording that mcap.writer made, as fast as possible or
 // paced by the depth images' device timestamps, optionally only a time window of it.
 //
-//   FILE.mcap ──> mcap.player ──> raw, color, truth
+//   FILE.mcap ──> mcap.player ──> raw, color, truth, distance (what the machine measured,
+//                                  when the recording holds it)
 //
 // Frames are rebuilt from the consecutive messages of a chunk that share a sequence
 // number (the frame id), in the order the chunks were written. A frame's device times
@@ -23,12 +24,14 @@
 
 #include "mcap/ground_truth_message.h"
 #include "mcap/mcap_reader.h"
+#include "mcap/measurement_messages.h"
 #include "mcap/raw_image.h"
 #include "mcap/recording_layout.h"
 #include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
+#include "tilth/messages/ground_distance.h"
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/playback_clock.h"
@@ -41,6 +44,7 @@ namespace {
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
+constexpr std::size_t kDistancePort = 3;
 
 // The messages of one frame, still encoded.
 struct RecordedFrame {
@@ -49,6 +53,7 @@ struct RecordedFrame {
   std::optional<Message> color;
   std::optional<Message> truth;
   std::optional<Message> mask;
+  std::optional<Message> distance;
 };
 
 std::uint64_t seconds_to_ns(double seconds) {
@@ -84,6 +89,7 @@ class McapPlayer final : public Source {
       if (channel.topic == kColorTopic) color_channel_ = id;
       if (channel.topic == kTruthTopic) truth_channel_ = id;
       if (channel.topic == kMaskTopic) mask_channel_ = id;
+      if (channel.topic == kDistanceTopic) distance_channel_ = id;
     }
     if (!raw_channel_ || !color_channel_) {
       throw Error(reader_.file().string() + ": expected channels " + std::string(kRawTopic) +
@@ -193,6 +199,8 @@ class McapPlayer final : public Source {
         frame.truth = std::move(message);
       } else if (channel == mask_channel_) {
         frame.mask = std::move(message);
+      } else if (channel == distance_channel_) {
+        frame.distance = std::move(message);
       }
     }
   }
@@ -232,6 +240,7 @@ class McapPlayer final : public Source {
     RawTofFrame raw;
     ColorImage color;
     GroundTruth truth;
+    std::optional<GroundDistance> distance;
   };
 
   Outputs decode(const RecordedFrame& recorded) const {
@@ -261,6 +270,9 @@ class McapPlayer final : public Source {
     if (recorded.mask) {
       outputs.truth.residue_mask = image(*recorded.mask, depth_size, "mono8").pixels;
     }
+    if (recorded.distance) {
+      outputs.distance = decode_ground_distance(recorded.distance->data, where(*recorded.distance));
+    }
     return outputs;
   }
 
@@ -270,6 +282,7 @@ class McapPlayer final : public Source {
     frame.emit(kRawPort, std::move(outputs.raw));
     frame.emit(kColorPort, std::move(outputs.color));
     frame.emit(kTruthPort, std::move(outputs.truth));
+    if (outputs.distance) frame.emit(kDistancePort, std::move(*outputs.distance));
   }
 
   McapReader reader_;
@@ -281,6 +294,7 @@ class McapPlayer final : public Source {
   std::optional<std::uint16_t> color_channel_;
   std::optional<std::uint16_t> truth_channel_;
   std::optional<std::uint16_t> mask_channel_;
+  std::optional<std::uint16_t> distance_channel_;
 
   std::uint64_t start_ns_ = 0;
   std::uint64_t end_ns_ = 0;
@@ -298,6 +312,9 @@ StageDescriptor describe() {
       PortSpec::of<ColorImage>("color",
                                "the colour image as recorded; device time = the image's timestamp"),
       PortSpec::of<GroundTruth>("truth", "the recorded distance and mask; empty when none"),
+      PortSpec::of<GroundDistance>("distance",
+                                   "what the machine measured (/tilth/distance), for the frames "
+                                   "that have it; nothing for the others"),
   };
   d.params = {
       ParamSpec::path("path", std::nullopt).describe("the MCAP file"),

@@ -61,7 +61,7 @@ class UsageTest(unittest.TestCase):
     def test_setting_without_value(self):
         self.assert_refused(ab(CASE_C, "--variant", "a:segment.dilation_px"),
                             "--variant a:segment.dilation_px: expected NAME:chain=FILE, "
-                            "NAME:NODE.type=STAGE_TYPE or NAME:NODE.PARAM=VALUE")
+                            "NAME:NODE.type=STAGE_TYPE, NAME:NODE.PARAM=VALUE or NAME:recorded")
 
     def test_unknown_node(self):
         self.assert_refused(ab(CASE_C, "--variant", "a:segmnt.dilation_px=3", "--out", self.out),

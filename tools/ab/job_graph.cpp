@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "framework/nearest_names.h"
+#include "mcap/mcap_reader.h"
+#include "mcap/recording_layout.h"
 #include "tilth/error.h"
 
 namespace tilth::ab {
@@ -41,15 +43,46 @@ NodeSpec* find_node(GraphSpec& graph, const std::string& name) {
   return nullptr;
 }
 
+bool holds_what_was_measured(const Recording& recording) {
+  if (recording.format != RecordingFormat::kMcap) return false;
+  const mcap::McapReader reader(recording.path);
+  for (const auto& [id, channel] : reader.channels()) {
+    if (channel.topic == mcap::kDistanceTopic) return true;
+  }
+  return false;
+}
+
 void take_problems(const GraphError& error, Diagnostics& problems) {
   for (const auto& item : error.diagnostics().items()) problems.add(item.where, item.message);
+}
+
+json runtime_of(const JobOptions& options) {
+  return {{"max_in_flight", options.max_in_flight}, {"when_full", "block"}, {"on_error", "skip"}};
+}
+
+// A recorded variant's graph: the player's recorded distance judged against its truth.
+json recorded_graph(const Variant& variant, const Recording& recording, json evaluation_params,
+                    const JobOptions& options) {
+  return {
+      {"description", "tilth ab: what the machine measured ('" + variant.name +
+                          "'), as recorded in " + recording.path.string()},
+      {"nodes",
+       {{"recording",
+         {{"type", player_type(recording.format)},
+          {"params", {{"path", recording.path.string()}}}}},
+        {"evaluation", {{"type", "sinks.evaluation"}, {"params", evaluation_params}}}}},
+      {"edges", json::array({{"recording.distance", "evaluation.distance"},
+                             {"recording.truth", "evaluation.truth"}})},
+      {"runtime", runtime_of(options)},
+  };
 }
 
 json replay_graph(const Variant& variant, const Recording& recording, const JobFiles& files,
                   const JobOptions& options) {
   const std::string chain = job_label(variant, recording) + "/";
   json evaluation_params = {{"path", files.frames.string()}};
-  if (options.save_images) evaluation_params["save_images"] = true;
+  if (options.save_images && !variant.recorded) evaluation_params["save_images"] = true;
+  if (variant.recorded) return recorded_graph(variant, recording, evaluation_params, options);
   json edges = json::array({
       {"recording.raw", chain + variant.ports.raw},
       {"recording.color", chain + variant.ports.color},
@@ -71,8 +104,7 @@ json replay_graph(const Variant& variant, const Recording& recording, const JobF
           {"params", {{"path", recording.path.string()}}}}},
         {"evaluation", {{"type", "sinks.evaluation"}, {"params", evaluation_params}}}}},
       {"edges", edges},
-      {"runtime",
-       {{"max_in_flight", options.max_in_flight}, {"when_full", "block"}, {"on_error", "skip"}}},
+      {"runtime", runtime_of(options)},
   };
 }
 
@@ -111,6 +143,13 @@ std::string job_label(const Variant& variant, const Recording& recording) {
 
 std::vector<fs::path> check_variant(Variant& variant, const GraphOverrides& variables,
                                     Diagnostics& problems) {
+  if (variant.recorded) {
+    for (const auto& setting : variant.settings) {
+      problems.add(setting.where, "variant '" + variant.name +
+                                      "' is recorded: it runs no chain, so it takes no settings");
+    }
+    return {};
+  }
   GraphSpec chain;
   try {
     chain = load_graph(variant.chain, {{}, variables.variables});
@@ -163,9 +202,21 @@ void check_stage_types(const Variant& variant, const StageRegistry& registry,
 std::optional<ValidatedGraph> job_graph(const Variant& variant, const Recording& recording,
                                         const JobFiles& files, const JobOptions& options,
                                         const StageRegistry& registry, Diagnostics& problems) {
+  if (variant.recorded && !holds_what_was_measured(recording)) {
+    problems.add(variant.chain_where,
+                 "variant '" + variant.name + "' is what the machine measured, and " +
+                     recording.path.string() + " does not hold it: " +
+                     (recording.format == RecordingFormat::kMcap
+                          ? "no " + std::string(mcap::kDistanceTopic) +
+                                " channel (recorded without mcap.writer's distance input)"
+                          : "only MCAP recordings do (docs/mcap.md)"));
+    return std::nullopt;
+  }
   write_file(files.graph, replay_graph(variant, recording, files, options).dump(2) + "\n");
   try {
-    GraphSpec graph = load_graph(files.graph, {{}, options.variables.variables});
+    // --var sets the chains' variables; a recorded variant has no chain.
+    GraphSpec graph = load_graph(
+        files.graph, {{}, variant.recorded ? std::vector<Setting>{} : options.variables.variables});
     apply_settings(variant, job_label(variant, recording) + "/", graph);
     return validate_graph(graph, registry);
   } catch (const GraphError& error) {

@@ -37,6 +37,8 @@ jobs that no shard finished (exit code 1).
                               NODE.type=STAGE_TYPE  another stage type for a node
                               NODE.PARAM=VALUE      a parameter (VALUE as with --set)
                               chain=FILE            another chain graph file
+                              recorded              no chain: what the machine measured,
+                                                    as an MCAP recording holds it
                             e.g. --variant wide:segment.dilation_px=4
   --variants FILE           variants from a JSON file
   --chain FILE              the chain the variants change

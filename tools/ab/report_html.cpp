@@ -126,8 +126,9 @@ std::string variants_section(const Comparison& comparison) {
           escape(setting.node + "." + setting.param + " = " +
                  (setting.command_line_text ? *setting.command_line_text : setting.value.dump()));
     }
+    if (variant.recorded) changes = "none: what the machine measured, as recorded";
     html += "<tr>" + cell(escape(variant.name), "name") +
-            cell(escape(variant.chain.string()), "name") +
+            cell(variant.recorded ? "&ndash;" : escape(variant.chain.string()), "name") +
             cell(changes.empty() ? "(as the chain is)" : changes, "name") +
             cell(escape(variant.description), "name") + "</tr>\n";
   }

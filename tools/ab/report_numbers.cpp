@@ -223,8 +223,9 @@ json variants_json(const std::vector<Variant>& variants) {
     for (const auto& setting : variant.settings) settings.push_back(setting_text(setting));
     list.push_back({{"name", variant.name},
                     {"description", variant.description},
-                    {"chain", variant.chain.string()},
-                    {"settings", settings}});
+                    {"chain", variant.recorded ? "" : variant.chain.string()},
+                    {"settings", settings},
+                    {"recorded", variant.recorded}});
   }
   return list;
 }

@@ -1,5 +1,6 @@
 // A variant of the measurement chain under test: which chain graph file it runs, which
-// of its nodes get another stage type, and which parameters it sets.
+// of its nodes get another stage type, and which parameters it sets; or what the
+// machine measured when the recording was made.
 #pragma once
 
 #include <filesystem>
@@ -47,6 +48,9 @@ struct Variant {
   Location chain_where;  // where the chain was chosen, for messages about it
   ChainPorts ports;
   std::vector<NodeSetting> settings;
+  // No chain: what the machine measured live, as an MCAP recording holds it
+  // (/tilth/distance), judged as a variant is.
+  bool recorded = false;
 };
 
 // Throws tilth::Error unless `name` is 1-64 letters, digits, '-' or '_'.

@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
 const std::vector<std::string> kFileKeys = {"chain", "variants"};
-const std::vector<std::string> kVariantKeys = {"name", "description", "chain", "ports", "set"};
+const std::vector<std::string> kVariantKeys = {"name",  "description", "chain",
+                                               "ports", "set",         "recorded"};
 const std::vector<std::string> kPortKeys = {"raw", "color", "distance", "mask", "registered_color"};
 
 Variant* find_variant(std::vector<Variant>& variants, const std::string& name) {
@@ -119,6 +120,19 @@ class FileReader {
     }
     if (entry.contains("ports")) read_ports(entry["ports"], where.child("ports"), variant.ports);
     if (entry.contains("set")) read_settings(entry["set"], where.child("set"), variant.settings);
+    if (entry.contains("recorded")) {
+      if (!entry["recorded"].is_boolean()) {
+        problems_.add(where.child("recorded"), "expected true or false");
+      } else if (entry["recorded"].get<bool>()) {
+        variant.recorded = true;
+        for (const char* key : {"chain", "ports", "set"}) {
+          if (entry.contains(key)) {
+            problems_.add(where.child(key), "a recorded variant runs no chain: no '" +
+                                                std::string(key) + "' with \"recorded\": true");
+          }
+        }
+      }
+    }
     variants.push_back(std::move(variant));
   }
 
@@ -207,16 +221,20 @@ void add_variant_option(const std::string& option, const fs::path& default_chain
   check_variant_name(name, where);
   Variant* variant = find_variant(variants, name);
   if (variant == nullptr) {
-    variants.push_back({name, "", default_chain, Location{"command line", where}, {}, {}});
+    variants.push_back({name, "", default_chain, Location{"command line", where}, {}, {}, false});
     variant = &variants.back();
   }
   if (colon == std::string::npos) return;
   const std::string setting = option.substr(colon + 1);
+  if (setting == "recorded") {
+    variant->recorded = true;
+    return;
+  }
   const auto equals = setting.find('=');
   if (equals == std::string::npos) {
     throw Error(where +
-                ": expected NAME:chain=FILE, NAME:NODE.type=STAGE_TYPE or "
-                "NAME:NODE.PARAM=VALUE");
+                ": expected NAME:chain=FILE, NAME:NODE.type=STAGE_TYPE, NAME:NODE.PARAM=VALUE "
+                "or NAME:recorded");
   }
   const std::string key = setting.substr(0, equals);
   const std::string value = setting.substr(equals + 1);
