@@ -26,10 +26,11 @@ const char* const kMergeUsage =
 
 Writes the report of a comparison run as shards ('tilth ab ... --shard I/N --out
 SHARD_DIR', on one machine or many) from the results they left in the SHARD_DIRs: the
-same report.html, summary.json, summary.csv and frames.csv that one run would have
-written, apart from timings. Every shard must have run the same comparison (variants,
-recordings, variables). A job whose shard did not finish is in the report as failed
-("missing") and listed here, with exit code 1: run that shard again, then merge again.
+same report.html, summary.json, summary.csv, conditions.csv and frames.csv that one run
+would have written, apart from timings and the stamp of how it was made. Every shard
+must have run the same comparison (variants, baseline, recordings, tags, variables). A
+job whose shard did not finish is in the report as failed ("missing") and listed here,
+with exit code 1: run that shard again, then merge again.
 
   --out DIR      where the report goes; missing or empty
   --overwrite    replace an earlier report in DIR
