@@ -14,6 +14,7 @@
 #include <thread>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "roi/region_of_interest.h"
 #include "tilth/error.h"
@@ -67,6 +68,10 @@ class LiveView final : public Sink {
     const ListenAddress address = parse_listen(listen);
     server_.emplace(address.host, address.port,
                     ViewServer::Content{&image_, &history_, [this] { return status(); }});
+    // OpenCV lists its codecs on first use, behind a guard ThreadSanitizer cannot see in
+    // uninstrumented OpenCV: listed here, before the renderer encodes on its own thread
+    // (as recording.image_folder does before its decoding threads).
+    cv::haveImageWriter(".jpg");
     renderer_ = std::thread([this] { render_loop(); });
     log_.info("live view at http://" + (address.host == "0.0.0.0" ? "HOST" : address.host) + ":" +
               std::to_string(server_->port()) + "/");
