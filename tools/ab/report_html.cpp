@@ -207,7 +207,7 @@ std::string conditions_section(const Comparison& comparison) {
       "within the condition.</p>\n<table><tr><th class=\"name\">condition</th>"
       "<th class=\"name\">value</th><th class=\"name\">variant</th><th>frames</th>"
       "<th>frames valid</th><th>frames missed</th><th>frames false valid</th>"
-      "<th>mean |error| (mm)</th><th>max |error| (mm)</th>"
+      "<th>mean |error| (mm)</th><th>max |error| (mm)</th><th>residue IoU</th>"
       "<th>mean |error| difference (mm)</th><th>95% CI over recordings (mm)</th>"
       "<th class=\"name\">distance verdict</th></tr>\n";
   for (const Condition& condition : conditions) {
@@ -221,6 +221,7 @@ std::string conditions_section(const Comparison& comparison) {
               cell(std::to_string(f.valid)) + count_cell(f.missed) + count_cell(f.false_valid) +
               cell(fixed(if_any(f.error, f.error.mean_abs_mm))) +
               cell(fixed(if_any(f.error, f.error.max_abs_mm))) +
+              cell(f.mask ? fixed(f.mask->iou(), 3) : std::string("&ndash;")) +
               cell(signed_fixed(p.abs_error_difference_mm)) +
               cell(interval(p.ci95_low_mm, p.ci95_high_mm)) +
               verdict_cell(distance_verdict(part, v, p)) + "</tr>\n";
