@@ -1,6 +1,9 @@
 // The residue segmentations on a 640x480 frame (the blaze-101's grid) of straw and soil,
 // in ms per frame: segmentation.color_threshold per colour space and dilation, and the
-// variants with their defaults (pixel_classifier needs a trained model and is left out).
+// variants with their defaults; pixel_classifier with the model that TILTH_BENCH_MODEL
+// names (a file of tilth train-segmenter), skipped without one, on the whole frame and in
+// the middle half the measurement chain segments.
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -86,6 +89,26 @@ BENCHMARK_CAPTURE(variant, depth_aided, describe_depth_aided)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(variant, fusion, describe_fusion)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// `roi`: the whole frame (null), or the middle half that the measurement chain segments.
+void pixel_classifier(benchmark::State& state, const nlohmann::json& roi) {
+  const char* model = std::getenv("TILTH_BENCH_MODEL");
+  if (model == nullptr) {
+    state.SkipWithError("TILTH_BENCH_MODEL names no model file (tilth train-segmenter --out)");
+    return;
+  }
+  testing::TransformHarness stage(describe_pixel_classifier(), {{"model", model}, {"roi", roi}});
+  const auto frame = straw_and_soil_frame();
+  for (auto _ : state) benchmark::DoNotOptimize(stage.run(frame));
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK_CAPTURE(pixel_classifier, whole, nlohmann::json())
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pixel_classifier, middle_half, nlohmann::json("middle_half"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace tilth::segmentation

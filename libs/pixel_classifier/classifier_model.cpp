@@ -1,6 +1,7 @@
 #include "pixel_classifier/classifier_model.h"
 
 #include <set>
+#include <vector>
 
 #include <opencv2/core/persistence.hpp>
 
@@ -39,30 +40,40 @@ void refuse_duplicate_keys(const std::filesystem::path& file, const cv::FileNode
 
 }  // namespace
 
-void write_classifier_model(const std::filesystem::path& file, const cv::ml::RTrees& forest,
-                            const std::string& training) {
+std::string_view classifier_kind_name(ClassifierKind kind) {
+  return kind == ClassifierKind::kForest ? "forest" : "boosted";
+}
+
+ClassifierKind classifier_kind_named(std::string_view name) {
+  if (name == "forest") return ClassifierKind::kForest;
+  if (name == "boosted") return ClassifierKind::kBoosted;
+  throw Error("classifier \"" + std::string(name) + "\" (expected forest or boosted)");
+}
+
+void write_classifier_model(const std::filesystem::path& file, const ClassifierModel& model) {
   cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
   if (!storage.isOpened()) fail(file, "cannot be written");
   storage << "format" << std::string(kClassifierFormat);
+  storage << "feature_set" << std::string(feature_set_id(model.features));
   storage << "features"
           << "[";
-  for (const auto& name : pixel_feature_names()) storage << name;
+  for (const auto& name : feature_names(model.features)) storage << name;
   storage << "]";
-  storage << "cell_bits" << kCellBits;
   storage << "smoothing_px" << kFeatureSmoothingPx;
+  storage << "classifier" << std::string(classifier_kind_name(model.kind));
   storage << "classes"
           << "["
           << "soil"
           << "residue"
           << "]";
-  storage << "training" << training;
-  storage << "forest"
+  storage << "training" << model.training;
+  storage << "trees"
           << "{";
-  forest.write(storage);
+  model.trees->write(storage);
   storage << "}";
 }
 
-cv::Ptr<cv::ml::RTrees> read_classifier_model(const std::filesystem::path& file) {
+ClassifierModel read_classifier_model(const std::filesystem::path& file) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(file, error)) {
     fail(file, "no such file (expected a model written by tilth train-segmenter)");
@@ -81,14 +92,25 @@ cv::Ptr<cv::ml::RTrees> read_classifier_model(const std::filesystem::path& file)
     fail(file, "format \"" + format.string() + "\" (expected \"" + std::string(kClassifierFormat) +
                    "\"; retrain with this version's tilth train-segmenter)");
   }
+  ClassifierModel model;
+  const cv::FileNode set = storage["feature_set"];
+  try {
+    model.features = feature_set_of(set.isString() ? set.string() : "");
+    const cv::FileNode kind = storage["classifier"];
+    model.kind = classifier_kind_named(kind.isString() ? kind.string() : "");
+  } catch (const Error& unknown) {
+    fail(file, unknown.what());
+  }
   std::vector<std::string> features;
   if (storage["features"].isSeq()) {
     for (const auto& name : storage["features"])
       features.push_back(name.isString() ? name.string() : "?");
   }
-  if (features != pixel_feature_names()) {
-    fail(file, "features " + joined(features) + " (expected " + joined(pixel_feature_names()) +
-                   "; retrain with this version's tilth train-segmenter)");
+  const std::vector<std::string>& expected = feature_names(model.features);
+  if (features != expected) {
+    fail(file, "features " + joined(features) + " (expected " + joined(expected) + " for \"" +
+                   std::string(feature_set_id(model.features)) +
+                   "\"; retrain with this version's tilth train-segmenter)");
   }
   std::vector<std::string> classes;
   if (storage["classes"].isSeq()) {
@@ -98,40 +120,34 @@ cv::Ptr<cv::ml::RTrees> read_classifier_model(const std::filesystem::path& file)
   if (classes != std::vector<std::string>{"soil", "residue"}) {
     fail(file, "classes " + joined(classes) + " (expected [soil, residue], labels 0 and 1)");
   }
-  const int cell_bits = storage["cell_bits"].isInt() ? static_cast<int>(storage["cell_bits"]) : -1;
   const int smoothing =
       storage["smoothing_px"].isInt() ? static_cast<int>(storage["smoothing_px"]) : -1;
-  if (cell_bits != kCellBits || smoothing != kFeatureSmoothingPx) {
-    fail(file, "colour cells of " + std::to_string(cell_bits) + " bits after " +
-                   std::to_string(smoothing) + " px smoothing (expected " +
-                   std::to_string(kCellBits) + " bits after " +
+  if (smoothing != kFeatureSmoothingPx) {
+    fail(file, "colours smoothed over " + std::to_string(smoothing) + " px (expected " +
                    std::to_string(kFeatureSmoothingPx) + " px)");
   }
-  if (!storage["forest"].isMap()) {
-    fail(file, "no 'forest' (expected the random forest written by tilth train-segmenter)");
+  const std::string kind(classifier_kind_name(model.kind));
+  if (!storage["trees"].isMap()) {
+    fail(file, "no 'trees' (expected the " + kind + " written by tilth train-segmenter)");
   }
-  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
+  if (model.kind == ClassifierKind::kForest) {
+    model.trees = cv::ml::RTrees::create();
+  } else {
+    model.trees = cv::ml::Boost::create();
+  }
   try {
-    forest->read(storage["forest"]);
+    model.trees->read(storage["trees"]);
   } catch (const cv::Exception& exception) {
-    fail(file, "the 'forest' cannot be read (" + exception.msg + ")");
+    fail(file, "the 'trees' cannot be read (" + exception.msg + ")");
   }
-  if (!forest->isTrained() || !forest->isClassifier() ||
-      forest->getVarCount() != static_cast<int>(features.size())) {
-    fail(file, "no trained random forest classifier of " + std::to_string(features.size()) +
-                   " features under 'forest'");
+  if (!model.trees->isTrained() || !model.trees->isClassifier() ||
+      model.trees->getVarCount() != static_cast<int>(features.size())) {
+    fail(file, "no trained " + kind + " classifier of " + std::to_string(features.size()) +
+                   " features under 'trees'");
   }
-  return forest;
-}
-
-std::vector<std::uint8_t> residue_by_cell(const cv::ml::StatModel& classifier) {
-  cv::Mat classes;
-  classifier.predict(cell_features(), classes);
-  std::vector<std::uint8_t> residue(kCellCount);
-  for (int cell = 0; cell < kCellCount; ++cell) {
-    residue[cell] = classes.at<float>(cell) == kResidueClass ? 255 : 0;
-  }
-  return residue;
+  const cv::FileNode training = storage["training"];
+  model.training = training.isString() ? training.string() : "";
+  return model;
 }
 
 }  // namespace tilth::segmentation

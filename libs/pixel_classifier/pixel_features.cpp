@@ -1,79 +1,89 @@
 #include "pixel_classifier/pixel_features.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
 
 #include <opencv2/imgproc.hpp>
 
 namespace tilth::segmentation {
-namespace {
 
-constexpr int kLevels = 1 << kCellBits;
-constexpr int kShift = 8 - kCellBits;
-// As segmentation.lab_clusters: below this lightness the ratios would amplify noise.
-constexpr float kMinLightness = 10.0f;
-
-cv::Mat compute_cell_features() {
-  // Every cell's centre colour as one pixel of a kLevels^2 x kLevels image, cell order.
-  cv::Mat centres(kLevels * kLevels, kLevels, CV_32FC3);
-  for (int cell = 0; cell < kCellCount; ++cell) {
-    const int b = cell >> (2 * kCellBits);
-    const int g = (cell >> kCellBits) & (kLevels - 1);
-    const int r = cell & (kLevels - 1);
-    auto centre = [](int level) { return ((level << kShift) + (1 << kShift) / 2.0f) / 255.0f; };
-    centres.at<cv::Vec3f>(cell / kLevels, cell % kLevels) = {centre(b), centre(g), centre(r)};
-  }
-  cv::Mat lab, hsv;
-  cv::cvtColor(centres, lab, cv::COLOR_BGR2Lab);
-  cv::cvtColor(centres, hsv, cv::COLOR_BGR2HSV);
-  const int count = static_cast<int>(pixel_feature_names().size());
-  cv::Mat features(kCellCount, count, CV_32FC1);
-  for (int cell = 0; cell < kCellCount; ++cell) {
-    const cv::Point at(cell % kLevels, cell / kLevels);
-    const cv::Vec3f bgr = centres.at<cv::Vec3f>(at);
-    const cv::Vec3f l = lab.at<cv::Vec3f>(at);
-    const cv::Vec3f h = hsv.at<cv::Vec3f>(at);
-    const float sum = bgr[0] + bgr[1] + bgr[2];
-    const float per_lightness = 100.0f / std::max(l[0], kMinLightness);
-    const float row[] = {l[0],
-                         l[1],
-                         l[2],
-                         h[0],
-                         h[1],
-                         h[2],
-                         (2 * bgr[1] - bgr[2] - bgr[0]) / sum,
-                         l[1] * per_lightness,
-                         l[2] * per_lightness};
-    std::copy(std::begin(row), std::end(row), features.ptr<float>(cell));
-  }
-  return features;
+int feature_reach_px(FeatureSet set) {
+  constexpr int kSobelPx = 1;
+  const int widest = *std::max_element(std::begin(kTextureWindowsPx), std::end(kTextureWindowsPx));
+  return kFeatureSmoothingPx + (set == FeatureSet::kColour ? 0 : kSobelPx + widest / 2);
 }
 
-}  // namespace
-
-const std::vector<std::string>& pixel_feature_names() {
-  static const std::vector<std::string> names = {"L*", "a*",  "b*",    "H",    "S",
-                                                 "V",  "exg", "a*/L*", "b*/L*"};
-  return names;
+void PixelFeatures::compute(FeatureSet set, const cv::Mat& bgr, const cv::Rect& area,
+                            const cv::Mat& counted) {
+  set_ = set;
+  const int reach = feature_reach_px(set);
+  const cv::Rect around =
+      cv::Rect(area.x - reach, area.y - reach, area.width + 2 * reach, area.height + 2 * reach) &
+      cv::Rect({}, bgr.size());
+  smoothed_colour(bgr(around), smoothed_);
+  const cv::Rect inside = area - around.tl();
+  if (set == FeatureSet::kColour) {
+    colour_.compute(smoothed_(inside));
+  } else {
+    texture_.compute(smoothed_, inside, counted);
+  }
 }
 
-void color_cells(const cv::Mat& bgr, cv::Mat& cells) {
-  thread_local cv::Mat mean;
-  const int side = 2 * kFeatureSmoothingPx + 1;
-  cv::blur(bgr, mean, {side, side}, {-1, -1}, cv::BORDER_REFLECT);
-  cells.create(bgr.size(), CV_32SC1);
+void PixelFeatures::at(int row, int col, float* out) const {
+  if (set_ == FeatureSet::kColour) {
+    colour_.at(row, col, out);
+  } else {
+    texture_.at(row, col, out);
+  }
+}
+
+void pixel_features(FeatureSet set, const cv::Mat& bgr, const cv::Mat& counted, cv::Mat& features) {
+  thread_local PixelFeatures planes;
+  planes.compute(set, bgr, cv::Rect({}, bgr.size()), counted);
+  features.create(static_cast<int>(bgr.total()), static_cast<int>(feature_names(set).size()),
+                  CV_32FC1);
   for (int row = 0; row < bgr.rows; ++row) {
-    const auto* in = mean.ptr<cv::Vec3b>(row);
-    auto* out = cells.ptr<std::int32_t>(row);
     for (int col = 0; col < bgr.cols; ++col) {
-      out[col] = ((in[col][0] >> kShift) << (2 * kCellBits)) |
-                 ((in[col][1] >> kShift) << kCellBits) | (in[col][2] >> kShift);
+      planes.at(row, col, features.ptr<float>(row * bgr.cols + col));
     }
   }
 }
 
-const cv::Mat& cell_features() {
-  static const cv::Mat features = compute_cell_features();
-  return features;
+void smoothed_colour(const cv::Mat& bgr, cv::Mat& smoothed) {
+  const int side = 2 * kFeatureSmoothingPx + 1;
+  cv::blur(bgr, smoothed, {side, side}, {-1, -1}, cv::BORDER_REFLECT);
+}
+
+void luminance(const cv::Mat& smoothed, cv::Mat& luminance_dn) {
+  luminance_dn.create(smoothed.size(), CV_32FC1);
+  for (int row = 0; row < smoothed.rows; ++row) {
+    const auto* in = smoothed.ptr<cv::Vec3b>(row);
+    auto* out = luminance_dn.ptr<float>(row);
+    for (int col = 0; col < smoothed.cols; ++col) {
+      out[col] = 0.114f * in[col][0] + 0.587f * in[col][1] + 0.299f * in[col][2];
+    }
+  }
+}
+
+float median_luminance(const cv::Mat& luminance_dn, const cv::Mat& counted) {
+  std::array<std::uint32_t, 256> histogram{};
+  std::uint64_t total = 0;
+  for (int row = 0; row < luminance_dn.rows; ++row) {
+    const auto* in = luminance_dn.ptr<float>(row);
+    const auto* use = counted.empty() ? nullptr : counted.ptr<std::uint8_t>(row);
+    for (int col = 0; col < luminance_dn.cols; ++col) {
+      if (use && !use[col]) continue;
+      ++histogram[std::clamp(static_cast<int>(std::lround(in[col])), 0, 255)];
+      ++total;
+    }
+  }
+  if (total == 0) return counted.empty() ? 1.0f : median_luminance(luminance_dn, cv::Mat());
+  std::uint64_t below = 0;
+  int level = 0;
+  while (below + histogram[level] <= (total - 1) / 2) below += histogram[level++];
+  return static_cast<float>(std::max(level, 1));
 }
 
 }  // namespace tilth::segmentation

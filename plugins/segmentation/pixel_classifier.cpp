@@ -1,20 +1,23 @@
-// segmentation.pixel_classifier: residue as a trained classifier (a random forest from
-// tilth train-segmenter) sees it, from each pixel's colour.
+// segmentation.pixel_classifier: residue as a trained classifier (a random forest or
+// boosted trees from tilth train-segmenter) sees it, from each pixel's colour and, with
+// the texture feature set, the luminance texture around it.
 //
-//   model file ──► forest ──► the class of every colour cell (at start: 262 144 cells)
-//   color ──► 3x3 mean, 6 bits per channel ──► cell ──► class ──► residue ──► despeckle ──►
-//   dilate ──► mask, soil_depth
+//   model file ──► trees, flattened (TreeEnsemble)
+//   color ──► 3x3 mean ──► the model's feature set, planes over the area ──► score > 0 on
+//   every scored_every_px-th pixel, and between them where they disagree ──► residue ──►
+//   despeckle ──► dilate ──► mask, soil_depth
 //
-// Invariant: the classifier sees exactly what it saw in training (pixel_features.h): the
-// colour cell of the pixel, described by the features of the cell's centre. So the class
-// of every cell can be looked up instead of running the forest per pixel, and the lookup
-// gives what the forest gives.
+// Invariant: the classifier sees what it saw in training: ResidueClassifier computes the
+// features with the code tilth train-segmenter samples them with, and scores them as the
+// trees' own predict() does. The texture set's luminance is normalised by the median over
+// the pixels whose colour is trusted in the segmented area; the features of that area's
+// edge come from the image around it, as in a whole image.
 //
 //   "segment": {"type": "segmentation.pixel_classifier", "params": {"model": "straw.yml.gz"}}
 #include <opencv2/core.hpp>
 
 #include "pixel_classifier/classifier_model.h"
-#include "pixel_classifier/pixel_features.h"
+#include "pixel_classifier/residue_classifier.h"
 #include "residue_output.h"
 #include "tilth/plugin.h"
 #include "variants.h"
@@ -25,25 +28,21 @@ namespace {
 class PixelClassifier final : public Transform {
  public:
   explicit PixelClassifier(const StageContext& context)
-      : residue_by_cell_(residue_by_cell(*read_classifier_model(context.params.path("model")))),
+      : classifier_(read_classifier_model(context.params.path("model")),
+                    static_cast<int>(context.params.integer("scored_every_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
         output_(context.params) {}
 
   void process(Frame& frame) override {
     const ResidueInputs in = read_residue_inputs(frame, min_value_, output_.area(frame));
-    thread_local cv::Mat cells, residue;
-    color_cells(in.bgr, cells);
-    residue.create(cells.size(), CV_8UC1);
-    for (int row = 0; row < cells.rows; ++row) {
-      const auto* cell = cells.ptr<std::int32_t>(row);
-      auto* out = residue.ptr<std::uint8_t>(row);
-      for (int col = 0; col < cells.cols; ++col) out[col] = residue_by_cell_[cell[col]];
-    }
+    thread_local cv::Mat trusted, residue;
+    cv::bitwise_not(in.untrusted, trusted);
+    classifier_.classify(frame.input<RegisteredColor>(kColorInput).bgr, in.area, trusted, residue);
     output_.emit(frame, in.area, residue, in.untrusted, in.unknown, in.depth_mm);
   }
 
  private:
-  const std::vector<std::uint8_t> residue_by_cell_;
+  const ResidueClassifier classifier_;
   const int min_value_;
   ResidueOutput output_;
 };
@@ -60,6 +59,11 @@ StageDescriptor describe_pixel_classifier() {
       ParamSpec::path("model", std::nullopt)
           .describe("model file written by tilth train-segmenter (" +
                     std::string(kClassifierFormat) + ")"),
+      ParamSpec::integer("scored_every_px", kScoredEveryPx)
+          .range(1, kMaxScoredEveryPx)
+          .in_unit("px")
+          .describe("the trees score every n-th pixel of every n-th row, and the pixels "
+                    "between them where those disagree; 1 = every pixel"),
       dilation_px_param(),
       segmented_roi_param(),
       speckle_px_param(1),

@@ -1,16 +1,19 @@
 // segmentation.pixel_classifier with a forest trained by tilth train-segmenter's own code
-// on painted frames: it classifies unseen frames as the forest does, pixel by pixel, and
-// every kind of bad model file stops it with a message naming the file and what was
-// expected.
+// on painted frames: it classifies unseen frames as OpenCV's forest does on the features
+// the trainer samples, pixel by pixel (so the stage and the trainer see the same
+// features), and every kind of bad model file stops it with a message naming the file and
+// what was expected.
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "painted_frame.h"
 #include "pixel_classifier/classifier_model.h"
 #include "pixel_classifier/pixel_features.h"
+#include "pixel_classifier/residue_classifier.h"
 #include "segmenter_training.h"
 #include "temp_dir.h"
 #include "variants.h"
@@ -51,37 +54,40 @@ RegisteredFrame banded_frame(int seed) {
 class TrainedModel : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    train_segmenter::TrainingSet training;
+    train_segmenter::TrainingSet training(FeatureSet::kTexture);
     for (int seed = 1; seed <= 3; ++seed) training.sample(banded_frame(seed), 500, seed);
-    forest_ = training.train(20, 8);
-    write_classifier_model(model(), *forest_, "painted bands, seeds 1-3");
+    model_ = training.train({ClassifierKind::kForest, 20, 8}, "painted bands, seeds 1-3");
+    write_classifier_model(model(), model_);
   }
-  static void TearDownTestSuite() { forest_.release(); }
+  static void TearDownTestSuite() { model_.trees.release(); }
   static std::filesystem::path model() { return directory().path() / "bands.yml.gz"; }
   static const testing::TempDir& directory() {
     static const testing::TempDir temp;
     return temp;
   }
-  static cv::Ptr<cv::ml::RTrees> forest_;
+  static ClassifierModel model_;
 };
 
-cv::Ptr<cv::ml::RTrees> TrainedModel::forest_;
+ClassifierModel TrainedModel::model_;
 
 TEST_F(TrainedModel, ClassifiesAnUnseenFrameAsTheForestDoes) {
   const RegisteredFrame frame = banded_frame(9);
   PaintedFrame painted(kSize, kSoils[0], kSoilMm);
   painted.color = std::const_pointer_cast<RegisteredColor>(frame.color);
-  const Segmented out =
-      segment(describe_pixel_classifier(),
-              {{"model", model().string()}, {"dilation_px", 0}, {"speckle_px", 0}}, painted);
-  cv::Mat cells;
-  color_cells(frame.color->bgr, cells);
+  const Segmented out = segment(
+      describe_pixel_classifier(),
+      {{"model", model().string()}, {"scored_every_px", 1}, {"dilation_px", 0}, {"speckle_px", 0}},
+      painted);
+  // The features as the trainer samples them: every pixel is trusted in a painted frame.
+  cv::Mat features;
+  pixel_features(FeatureSet::kTexture, frame.color->bgr,
+                 frame.color->status == RegisteredColor::kValid, features);
   int disagreements = 0, errors = 0, judged = 0;
   for (int row = 0; row < kSize.height; ++row) {
     for (int col = 0; col < kSize.width; ++col) {
-      const int cell = cells.at<std::int32_t>(row, col);
       const bool forest_says_residue =
-          forest_->predict(cell_features().row(cell)) == static_cast<float>(kResidueClass);
+          model_.trees->predict(features.row(row * kSize.width + col)) ==
+          static_cast<float>(kResidueClass);
       const bool stage_says_residue = out.mask.at<std::uint8_t>(row, col) == ResidueMask::kResidue;
       disagreements += forest_says_residue != stage_says_residue;
       const std::uint8_t truth = frame.truth->residue_mask.at<std::uint8_t>(row, col);
@@ -93,14 +99,49 @@ TEST_F(TrainedModel, ClassifiesAnUnseenFrameAsTheForestDoes) {
   EXPECT_EQ(disagreements, 0);
   // The shadowed straw (60, 95, 110) and the brown soil (55, 80, 110) lie 15 DN apart in
   // green; with 3 DN of noise on each channel a few pixels in a thousand land nearer the
-  // other colour (3 of 5504 here).
+  // other colour.
   EXPECT_LE(errors, judged / 500) << "of " << judged;
+}
+
+// Scoring every 2nd pixel of every 2nd row changes a decision only where the scored pixels
+// around it agree with each other: every boundary between them is refined.
+TEST_F(TrainedModel, ScoringAGridDiffersOnlyInsideAgreeingCells) {
+  const RegisteredFrame frame = banded_frame(9);
+  const cv::Rect whole({}, kSize);
+  const cv::Mat trusted = frame.color->status == RegisteredColor::kValid;
+  cv::Mat every, grid;
+  ResidueClassifier(model_, 1).classify(frame.color->bgr, whole, trusted, every);
+  ResidueClassifier(model_, 2).classify(frame.color->bgr, whole, trusted, grid);
+  // The scored rows (columns) around a row (column): itself, or the ones on either side.
+  const auto around = [](int index, int count) {
+    return index % 2 == 0 || index == count - 1 ? std::vector<int>{index}
+                                                : std::vector<int>{index - 1, index + 1};
+  };
+  int differing = 0;
+  for (int row = 0; row < kSize.height; ++row) {
+    for (int col = 0; col < kSize.width; ++col) {
+      if (every.at<std::uint8_t>(row, col) == grid.at<std::uint8_t>(row, col)) continue;
+      ++differing;
+      const std::vector<int> rows = around(row, kSize.height), cols = around(col, kSize.width);
+      ASSERT_GT(rows.size() + cols.size(), 2u) << "a scored pixel, " << row << ", " << col;
+      for (const int r : rows) {
+        for (const int c : cols) {
+          EXPECT_EQ(every.at<std::uint8_t>(r, c), grid.at<std::uint8_t>(row, col))
+              << "around " << row << ", " << col;
+        }
+      }
+    }
+  }
+  // The bands' boundaries are where the decisions change: refined, all of them.
+  EXPECT_LE(differing, kSize.area() / 200);
 }
 
 TEST_F(TrainedModel, ModelFileRecordsFormatFeaturesAndTraining) {
   cv::FileStorage storage(model().string(), cv::FileStorage::READ);
   EXPECT_EQ(storage["format"].string(), kClassifierFormat);
-  EXPECT_EQ(storage["features"].size(), pixel_feature_names().size());
+  EXPECT_EQ(storage["feature_set"].string(), "texture/1");
+  EXPECT_EQ(storage["features"].size(), feature_names(FeatureSet::kTexture).size());
+  EXPECT_EQ(storage["classifier"].string(), "forest");
   EXPECT_EQ(storage["training"].string(), "painted bands, seeds 1-3");
 }
 
@@ -117,9 +158,9 @@ std::string construction_error(const std::filesystem::path& model) {
 std::string edited_model(const std::string& from, const std::string& to) {
   testing::TempDir temp;
   const auto file = temp.path() / "model.yml";
-  train_segmenter::TrainingSet training;
+  train_segmenter::TrainingSet training(FeatureSet::kColour);
   training.sample(banded_frame(1), 50, 1);
-  write_classifier_model(file, *training.train(2, 2), "tiny");
+  write_classifier_model(file, training.train({ClassifierKind::kForest, 2, 2}, "tiny"));
   std::ifstream in(file);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto at = text.find(from);
@@ -142,14 +183,30 @@ TEST(PixelClassifierModel, NotAModelFile) {
       << error;
 }
 
+// Format 1 (a forest over colour cells) is not read: its colour/1 set is trained anew.
 TEST(PixelClassifierModel, AnotherFormatVersion) {
   testing::TempDir temp;
   const auto file =
-      temp.write("straw.yml", edited_model("tilth-pixel-classifier/1", "tilth-pixel-classifier/2"));
+      temp.write("straw.yml", edited_model("tilth-pixel-classifier/2", "tilth-pixel-classifier/1"));
   EXPECT_EQ(construction_error(file),
             "model file '" + file.string() +
-                "': format \"tilth-pixel-classifier/2\" (expected \"tilth-pixel-classifier/1\"; "
+                "': format \"tilth-pixel-classifier/1\" (expected \"tilth-pixel-classifier/2\"; "
                 "retrain with this version's tilth train-segmenter)");
+}
+
+TEST(PixelClassifierModel, UnknownFeatureSet) {
+  testing::TempDir temp;
+  const auto file = temp.write("straw.yml", edited_model("colour/1", "colour/7"));
+  EXPECT_EQ(construction_error(file),
+            "model file '" + file.string() +
+                "': feature set \"colour/7\" (expected \"colour/1\" or \"texture/1\")");
+}
+
+TEST(PixelClassifierModel, UnknownClassifier) {
+  testing::TempDir temp;
+  const auto file = temp.write("straw.yml", edited_model("classifier: forest", "classifier: svm"));
+  EXPECT_EQ(construction_error(file),
+            "model file '" + file.string() + "': classifier \"svm\" (expected forest or boosted)");
 }
 
 TEST(PixelClassifierModel, OtherFeatures) {
@@ -158,15 +215,16 @@ TEST(PixelClassifierModel, OtherFeatures) {
   EXPECT_EQ(construction_error(file),
             "model file '" + file.string() +
                 "': features [L*, a*, b*, H, S, V, exg, a*/L*, NDVI] (expected [L*, a*, b*, H, S, "
-                "V, exg, a*/L*, b*/L*]; retrain with this version's tilth train-segmenter)");
+                "V, exg, a*/L*, b*/L*] for \"colour/1\"; retrain with this version's tilth "
+                "train-segmenter)");
 }
 
-TEST(PixelClassifierModel, NoForest) {
+TEST(PixelClassifierModel, NoTrees) {
   testing::TempDir temp;
-  const auto file = temp.write("straw.yml", edited_model("forest:", "woods:"));
+  const auto file = temp.write("straw.yml", edited_model("trees:", "woods:"));
   EXPECT_EQ(construction_error(file),
             "model file '" + file.string() +
-                "': no 'forest' (expected the random forest written by tilth train-segmenter)");
+                "': no 'trees' (expected the forest written by tilth train-segmenter)");
 }
 
 // OpenCV would keep the first "training" and ignore the second.

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <random>
 
-#include "pixel_classifier/classifier_model.h"
 #include "pixel_classifier/pixel_features.h"
 #include "tilth/error.h"
 #include "tilth/messages/residue_mask.h"
@@ -14,9 +13,9 @@ namespace {
 using segmentation::kResidueClass;
 using segmentation::kSoilClass;
 
-// Calls `visit(cell, label)` for every pixel that takes part.
-template <class Visit>
-bool for_each_labelled_pixel(const RegisteredFrame& frame, Visit visit) {
+// The frame's features (pixel_features, normalised over its trusted pixels, as the stage
+// does) and which pixels take part; false when the frame has no ground-truth mask.
+bool labelled_pixels(const RegisteredFrame& frame, cv::Mat& trusted) {
   const cv::Mat& truth = frame.truth->residue_mask;
   if (truth.empty()) return false;
   if (truth.size() != frame.color->bgr.size() || truth.type() != CV_8UC1) {
@@ -25,85 +24,135 @@ bool for_each_labelled_pixel(const RegisteredFrame& frame, Visit visit) {
                 " (expected 8-bit, the depth image's " + std::to_string(frame.color->bgr.cols) +
                 "x" + std::to_string(frame.color->bgr.rows) + ")");
   }
-  thread_local cv::Mat cells;
-  segmentation::color_cells(frame.color->bgr, cells);
-  for (int row = 0; row < truth.rows; ++row) {
-    const auto* label = truth.ptr<std::uint8_t>(row);
-    const auto* status = frame.color->status.ptr<std::uint8_t>(row);
-    const auto* cell = cells.ptr<std::int32_t>(row);
-    for (int col = 0; col < truth.cols; ++col) {
-      if (status[col] != RegisteredColor::kValid) continue;
-      if (label[col] == ResidueMask::kSoil) visit(cell[col], kSoilClass);
-      if (label[col] == ResidueMask::kResidue) visit(cell[col], kResidueClass);
-    }
-  }
+  trusted = frame.color->status == RegisteredColor::kValid;
   return true;
+}
+
+double ratio(std::uint64_t part, std::uint64_t whole) {
+  return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
 }
 
 }  // namespace
 
 bool TrainingSet::sample(const RegisteredFrame& frame, std::size_t per_class, std::uint64_t seed) {
-  std::array<std::vector<std::int32_t>, 2> by_class;
-  const bool labelled = for_each_labelled_pixel(
-      frame, [&](std::int32_t cell, int label) { by_class[label].push_back(cell); });
-  if (!labelled) return false;
+  thread_local cv::Mat trusted, features;
+  if (!labelled_pixels(frame, trusted)) return false;
+  segmentation::pixel_features(features_, frame.color->bgr, trusted, features);
+  const cv::Mat& truth = frame.truth->residue_mask;
+  std::array<std::vector<int>, 2> by_class;
+  for (int row = 0; row < truth.rows; ++row) {
+    const auto* label = truth.ptr<std::uint8_t>(row);
+    const auto* use = trusted.ptr<std::uint8_t>(row);
+    for (int col = 0; col < truth.cols; ++col) {
+      if (!use[col]) continue;
+      if (label[col] == ResidueMask::kSoil) by_class[kSoilClass].push_back(row * truth.cols + col);
+      if (label[col] == ResidueMask::kResidue) {
+        by_class[kResidueClass].push_back(row * truth.cols + col);
+      }
+    }
+  }
   std::mt19937_64 rng(seed);
   for (int label : {kSoilClass, kResidueClass}) {
-    std::vector<std::int32_t> drawn;
+    std::vector<int> drawn;
     std::sample(by_class[label].begin(), by_class[label].end(), std::back_inserter(drawn),
                 per_class, rng);
-    cells_.insert(cells_.end(), drawn.begin(), drawn.end());
+    for (const int pixel : drawn) samples_.push_back(features.row(pixel));
     labels_.insert(labels_.end(), drawn.size(), label);
     counts_[label] += drawn.size();
   }
   return true;
 }
 
-cv::Ptr<cv::ml::RTrees> TrainingSet::train(int trees, int depth) const {
+void TrainingSet::add(const TrainingSet& other) {
+  if (other.features_ != features_) throw Error("training sets of two feature sets");
+  if (other.samples_.empty()) return;
+  samples_.push_back(other.samples_);
+  labels_.insert(labels_.end(), other.labels_.begin(), other.labels_.end());
+  counts_[0] += other.counts_[0];
+  counts_[1] += other.counts_[1];
+}
+
+segmentation::ClassifierModel TrainingSet::train(const ClassifierOptions& options,
+                                                 const std::string& training) const {
   if (soil() == 0 || residue() == 0) {
     throw Error("the training frames show " + std::to_string(soil()) + " soil and " +
                 std::to_string(residue()) +
                 " residue pixels (expected both classes in the ground-truth masks)");
   }
-  const cv::Mat& table = segmentation::cell_features();
-  cv::Mat features(static_cast<int>(cells_.size()), table.cols, CV_32F);
-  for (std::size_t i = 0; i < cells_.size(); ++i)
-    table.row(cells_[i]).copyTo(features.row(static_cast<int>(i)));
   const cv::Mat responses(labels_, true);
-
-  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
-  forest->setMaxDepth(depth);
-  forest->setMinSampleCount(5);
-  forest->setTermCriteria({cv::TermCriteria::MAX_ITER, trees, 0});
-  forest->train(cv::ml::TrainData::create(features, cv::ml::ROW_SAMPLE, responses));
-  return forest;
-}
-
-HeldOutPixels::HeldOutPixels() : counts_(segmentation::kCellCount) {}
-
-bool HeldOutPixels::add(const RegisteredFrame& frame) {
-  return for_each_labelled_pixel(frame, [&](std::int32_t cell, int label) {
-    ++counts_[cell][label];
-    ++pixels_;
-  });
-}
-
-Scores HeldOutPixels::score(const std::vector<std::uint8_t>& residue_by_cell) const {
-  std::uint64_t true_residue = 0, false_residue = 0, missed_residue = 0, true_soil = 0;
-  for (std::size_t cell = 0; cell < counts_.size(); ++cell) {
-    const bool residue = residue_by_cell[cell] != 0;
-    (residue ? false_residue : true_soil) += counts_[cell][kSoilClass];
-    (residue ? true_residue : missed_residue) += counts_[cell][kResidueClass];
+  cv::Mat weights(static_cast<int>(labels_.size()), 1, CV_32F);
+  const double all = static_cast<double>(labels_.size());
+  for (std::size_t i = 0; i < labels_.size(); ++i) {
+    weights.at<float>(static_cast<int>(i)) = static_cast<float>(all / (2.0 * counts_[labels_[i]]));
   }
-  auto ratio = [](std::uint64_t part, std::uint64_t whole) {
-    return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
-  };
+  // Integer responses: OpenCV takes the labels as classes.
+  const auto data = cv::ml::TrainData::create(samples_, cv::ml::ROW_SAMPLE, responses,
+                                              cv::noArray(), cv::noArray(), weights);
+  segmentation::ClassifierModel model;
+  model.features = features_;
+  model.kind = options.kind;
+  model.training = training;
+  if (options.kind == segmentation::ClassifierKind::kForest) {
+    cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
+    forest->setMaxDepth(options.depth);
+    forest->setMinSampleCount(5);
+    forest->setTermCriteria({cv::TermCriteria::MAX_ITER, options.trees, 0});
+    model.trees = forest;
+  } else {
+    cv::Ptr<cv::ml::Boost> boost = cv::ml::Boost::create();
+    boost->setBoostType(cv::ml::Boost::REAL);
+    boost->setWeakCount(options.trees);
+    boost->setMaxDepth(options.depth);
+    boost->setMinSampleCount(5);
+    boost->setUseSurrogates(false);
+    model.trees = boost;
+  }
+  // OpenCV draws from the calling thread's theRNG(): seeded, the same samples give the
+  // same trees whatever was trained before.
+  cv::theRNG() = cv::RNG(options.seed);
+  model.trees->train(data);
+  return model;
+}
+
+std::uint64_t Scores::pixels() const {
+  return true_residue + false_residue + missed_residue + true_soil;
+}
+double Scores::accuracy() const { return ratio(true_residue + true_soil, pixels()); }
+double Scores::residue_iou() const {
+  return ratio(true_residue, true_residue + false_residue + missed_residue);
+}
+double Scores::precision() const { return ratio(true_residue, true_residue + false_residue); }
+double Scores::recall() const { return ratio(true_residue, true_residue + missed_residue); }
+
+Scores& Scores::operator+=(const Scores& other) {
+  true_residue += other.true_residue;
+  false_residue += other.false_residue;
+  missed_residue += other.missed_residue;
+  true_soil += other.true_soil;
+  return *this;
+}
+
+std::optional<Scores> score_frame(const segmentation::ResidueClassifier& classifier,
+                                  const RegisteredFrame& frame) {
+  thread_local cv::Mat trusted, residue;
+  if (!labelled_pixels(frame, trusted)) return std::nullopt;
+  classifier.classify(frame.color->bgr, cv::Rect({}, frame.color->bgr.size()), trusted, residue);
+  const cv::Mat& truth = frame.truth->residue_mask;
   Scores scores;
-  scores.pixels = pixels_;
-  scores.accuracy = ratio(true_residue + true_soil, pixels_);
-  scores.residue_iou = ratio(true_residue, true_residue + false_residue + missed_residue);
-  scores.precision = ratio(true_residue, true_residue + false_residue);
-  scores.recall = ratio(true_residue, true_residue + missed_residue);
+  for (int row = 0; row < truth.rows; ++row) {
+    const auto* label = truth.ptr<std::uint8_t>(row);
+    const auto* use = trusted.ptr<std::uint8_t>(row);
+    const auto* said = residue.ptr<std::uint8_t>(row);
+    for (int col = 0; col < truth.cols; ++col) {
+      if (!use[col]) continue;
+      const bool residue_said = said[col] != 0;
+      if (label[col] == ResidueMask::kSoil)
+        (residue_said ? scores.false_residue : scores.true_soil)++;
+      if (label[col] == ResidueMask::kResidue) {
+        (residue_said ? scores.true_residue : scores.missed_residue)++;
+      }
+    }
+  }
   return scores;
 }
 

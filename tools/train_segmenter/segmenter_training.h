@@ -1,61 +1,71 @@
-// Training segmentation.pixel_classifier's forest from frames with ground-truth masks:
-// pixels sampled per frame and class, the forest, and its scores on held-out frames.
+// Training segmentation.pixel_classifier's trees from frames with ground-truth masks:
+// pixels sampled per frame and class, the classifier, and its scores on labelled frames.
 // Only pixels whose colour is trusted and whose truth is soil or residue (not mixed)
 // take part.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/ml.hpp>
+#include <opencv2/core/mat.hpp>
 
+#include "pixel_classifier/classifier_model.h"
+#include "pixel_classifier/residue_classifier.h"
 #include "registered_frames.h"
 
 namespace tilth::train_segmenter {
 
+struct ClassifierOptions {
+  segmentation::ClassifierKind kind = segmentation::ClassifierKind::kForest;
+  int trees = 5;           // trees of a forest, weak trees of boosting
+  int depth = 6;           // deepest level of a tree
+  std::uint64_t seed = 1;  // of OpenCV's draws (bootstrap samples, features tried per split)
+};
+
 class TrainingSet {
  public:
+  explicit TrainingSet(segmentation::FeatureSet features) : features_(features) {}
+
   // Adds up to `per_class` pixels of each class of the frame, drawn with `seed` (the same
   // seed, the same pixels). Returns false when the frame has no ground-truth mask.
   bool sample(const RegisteredFrame& frame, std::size_t per_class, std::uint64_t seed);
+  // Adds another set's samples (of the same feature set).
+  void add(const TrainingSet& other);
 
+  segmentation::FeatureSet features() const { return features_; }
   std::size_t soil() const { return counts_[0]; }
   std::size_t residue() const { return counts_[1]; }
 
-  // Random forest of `trees` trees no deeper than `depth`, on the samples' features.
-  // Throws tilth::Error when a class has no samples.
-  cv::Ptr<cv::ml::RTrees> train(int trees, int depth) const;
+  // The classifier of `options` on the samples, the classes weighted equally (each sample
+  // by all samples / (2 x its class's samples)). Throws tilth::Error when a class has no
+  // samples.
+  segmentation::ClassifierModel train(const ClassifierOptions& options,
+                                      const std::string& training) const;
 
  private:
-  std::vector<std::int32_t> cells_;
+  segmentation::FeatureSet features_;
+  cv::Mat samples_;  // one row of features per sample
   std::vector<std::int32_t> labels_;
   std::array<std::size_t, 2> counts_{};
 };
 
+// Pixel counts of a classifier's decisions against the truth.
 struct Scores {
-  std::uint64_t pixels = 0;
-  double accuracy = 0;     // share of pixels classified as the truth says
-  double residue_iou = 0;  // |predicted and true residue| / |predicted or true residue|
-  double precision = 0;    // of the pixels called residue, the share that is residue
-  double recall = 0;       // of the residue pixels, the share called residue
+  std::uint64_t true_residue = 0, false_residue = 0, missed_residue = 0, true_soil = 0;
+
+  std::uint64_t pixels() const;
+  double accuracy() const;     // share of pixels classified as the truth says
+  double residue_iou() const;  // |predicted and true residue| / |predicted or true residue|
+  double precision() const;    // of the pixels called residue, the share that is residue
+  double recall() const;       // of the residue pixels, the share called residue
+  Scores& operator+=(const Scores& other);
 };
 
-// Counts, per colour cell, the held-out pixels of each class, so that any classifier of
-// colour cells can be scored on them at once.
-class HeldOutPixels {
- public:
-  HeldOutPixels();
-  // Returns false when the frame has no ground-truth mask.
-  bool add(const RegisteredFrame& frame);
-  // `residue_by_cell`: 255 residue, 0 soil, per colour cell.
-  Scores score(const std::vector<std::uint8_t>& residue_by_cell) const;
-  std::uint64_t pixels() const { return pixels_; }
-
- private:
-  std::vector<std::array<std::uint32_t, 2>> counts_;  // per cell: soil, residue
-  std::uint64_t pixels_ = 0;
-};
+// The classifier's scores on a frame; empty when the frame has no ground-truth mask.
+std::optional<Scores> score_frame(const segmentation::ResidueClassifier& classifier,
+                                  const RegisteredFrame& frame);
 
 }  // namespace tilth::train_segmenter
