@@ -123,6 +123,7 @@ class Runtime::Impl {
           admit(sequence, std::move(bundles));
         },
         limits_.max_frames);
+    constructed_.store(true, std::memory_order_release);
   }
 
   RunResult run() {
@@ -168,8 +169,11 @@ class Runtime::Impl {
     interrupt_sources();
   }
 
+  // Empty while the stages are still being made: a stage may ask from a thread of its own
+  // (the live view's server) as soon as it exists.
   PipelineMetrics metrics() const {
     PipelineMetrics result;
+    if (!constructed_.load(std::memory_order_acquire)) return result;
     for (const auto& node : nodes_) {
       result.stages.push_back({node->spec.name, node->type(), node->latency.summary(),
                                node->errors.load(), node->skipped.load()});
@@ -496,6 +500,7 @@ class Runtime::Impl {
   std::size_t admission_slots_ = 0;
   std::size_t terminal_count_ = 0;
   std::unique_ptr<FrameAdmission> admission_;
+  std::atomic<bool> constructed_{false};  // nodes_ and admission_ are complete
   std::atomic<bool> stopping_{false};
   std::atomic<bool> stop_requested_{false};
 

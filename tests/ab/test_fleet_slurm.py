@@ -14,6 +14,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+from ports import free_port  # noqa: E402
 from processes import interrupt, start_logged  # noqa: E402
 
 from fleet_support import SLURM, TILTH, assert_same_as_single_run, fleet_environment  # noqa: E402
@@ -27,12 +28,6 @@ class PortTaken(RuntimeError):
 TIMEOUT = 120  # seconds for the array and the merge to end
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def tail(path, lines=30):
     try:
         with open(path, errors="replace") as f:
@@ -44,8 +39,9 @@ def tail(path, lines=30):
 class SlurmClusterTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        # The daemons' ports are free when chosen but another test may take one before a
-        # daemon binds it: then the cluster starts again on other ports.
+        # The daemons' ports are free when chosen (below the ephemeral range, which no
+        # outgoing connection takes) but another test may choose one too before a daemon
+        # binds it: then the cluster starts again on other ports.
         for attempt in range(ATTEMPTS):
             cls.folder = tempfile.mkdtemp(prefix="tilth-fleet-slurm-")
             cls.daemons = []

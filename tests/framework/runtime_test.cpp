@@ -294,6 +294,19 @@ TEST_F(RuntimeTest, EveryStageIsTimed) {
   EXPECT_GT(result.metrics.frames_per_second, 0.0);
 }
 
+// The live view's server answers status requests from its own thread as soon as its stage
+// exists, while the runtime is still making the others (a segfault in CI once).
+TEST_F(RuntimeTest, MetricsAskedForWhileStagesAreMadeAreEmpty) {
+  const RunResult result = run(R"({
+    "nodes": {"a_probe": {"type": "test.metrics_probe"},
+              "src": {"type": "test.counter", "params": {"count": 3}}},
+    "edges": [["src.out", "a_probe.in"]]
+  })");
+  EXPECT_EQ(sink_log("a_probe").stages_in_metrics_at_start, 0u);
+  EXPECT_EQ(sink_log("a_probe").frames.size(), 3u);
+  EXPECT_EQ(result.metrics.stages.size(), 2u);
+}
+
 TEST_F(RuntimeTest, FrameRateLeavesOutStartUp) {
   // 20 frames 10 ms apart, the first after 2 s: about 100 frames/s once running.
   // Counting the start-up would give 20 / 2.19 s = 9.1. A loaded machine may stretch the

@@ -153,6 +153,22 @@ class Record final : public Sink {
   const std::int64_t delay_us_;
 };
 
+// Asks for the pipeline's metrics in its constructor, as a stage with a thread of its own
+// (a server) may at any moment once it exists; then records as test.record does.
+class MetricsProbe final : public Sink {
+ public:
+  explicit MetricsProbe(const StageContext& c) : log_(sink_log(c.node)) {
+    log_.stages_in_metrics_at_start = c.pipeline_metrics().stages.size();
+  }
+  void consume(const Frame& frame) override {
+    std::lock_guard lock(log_.mutex);
+    log_.frames.push_back({frame.info(), frame.input<Count>(0).value, false});
+  }
+
+ private:
+  SinkLog& log_;
+};
+
 // Reports every `every`-th frame (by value) as lost data, as a writer on a full disk does.
 class Lossy final : public Sink {
  public:
@@ -243,6 +259,9 @@ void register_test_stages(StageRegistry& registry) {
   registry.add(describe("test.lossy", {count("in")}, {},
                         {ParamSpec::integer("every", 5).range(1, std::nullopt).describe("period")},
                         Concurrency::kSerial, factory<Lossy>()),
+               "test_stages");
+  registry.add(describe("test.metrics_probe", {count("in")}, {}, {}, Concurrency::kSerial,
+                        factory<MetricsProbe>()),
                "test_stages");
   registry.add(describe("test.needs_path", {count("in")}, {},
                         {ParamSpec::path("file", std::nullopt).describe("where to write")},

@@ -1,7 +1,8 @@
 // Stage types for the framework tests, registered in-process (StageRegistry::add):
 // a counting source, a parallel transform with a settable delay, a two-input adder, a
-// synchronizer pairing equal counts, a stage that throws on chosen frames, and a sink
-// that records what it receives.
+// synchronizer pairing equal counts, a stage that throws on chosen frames, a sink that
+// records what it receives, and one that asks for the pipeline's metrics while the
+// runtime is still making its stages.
 #pragma once
 
 #include <atomic>
@@ -35,6 +36,7 @@ struct SinkLog {
   std::atomic<int> concurrent{0};
   std::atomic<int> max_concurrent{0};
   bool finished = false;
+  std::size_t stages_in_metrics_at_start = 0;  // test.metrics_probe: what its constructor saw
 };
 
 SinkLog& sink_log(const std::string& node);

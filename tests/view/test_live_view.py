@@ -62,8 +62,20 @@ class Tilth:
         assert self.url, "no live view address in the log:\n" + "".join(self.lines)
 
     def get(self, path, timeout=10):
-        with urllib.request.urlopen(self.url + path, timeout=timeout) as reply:
-            return reply.status, dict(reply.headers), reply.read()
+        try:
+            with urllib.request.urlopen(self.url + path, timeout=timeout) as reply:
+                return reply.status, dict(reply.headers), reply.read()
+        except OSError as error:
+            raise AssertionError("GET %s: %s\n%s" % (path, error, self.exit_report())) from error
+
+    def exit_report(self):
+        """Whether tilth run is still running, and the end of its log."""
+        try:
+            code = self.process.wait(2)
+            state = "tilth run exited with code %d" % code
+        except subprocess.TimeoutExpired:
+            state = "tilth run is still running"
+        return state + "; its log ends:\n" + "".join(self.lines[-40:])
 
     def status(self):
         return json.loads(self.get("status.json")[2])
