@@ -35,7 +35,7 @@ struct PipelineMetrics : MessageOf<PipelineMetrics> {
   std::uint64_t frames_dropped = 0;  // dropped at admission because the pipeline was full
   std::uint64_t frames_in_flight = 0;
   double frames_per_second = 0.0;  // from the first frame done to the last: no start-up
-  LatencySummary end_to_end;  // from capture (host clock) to the last sink
+  LatencySummary end_to_end;       // from capture (host clock) to the last sink
 
   std::string summary() const override;
 };
