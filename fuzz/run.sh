@@ -20,7 +20,7 @@ fi
 seconds=$1
 shift
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(graph_file calibration frames_csv mcap_reader modbus_request)
+[ ${#targets[@]} -gt 0 ] || targets=(graph_file calibration frames_csv png_decoder mcap_reader modbus_request)
 build=${TILTH_FUZZ_BUILD:-build-fuzz}
 work=${TILTH_FUZZ_WORK:-$build/fuzz-work}
 

@@ -16,7 +16,7 @@ packages=(
   # machine outputs and their real peers in tests
   libmodbus-dev mbpoll python3-pymodbus python3-serial python3-serial-asyncio
   # recordings
-  libzstd-dev liblz4-dev zlib1g-dev nodejs
+  libzstd-dev liblz4-dev zlib1g-dev libdeflate-dev nodejs
   # running as a systemd service; the packages (cpack) and their test in a bare root
   libsystemd-dev systemd dpkg-dev file debootstrap
   # the live view's web server

@@ -37,6 +37,7 @@
 #include "mcap/crc32.h"
 #include "mcap/mcap_reader.h"
 #include "mcap/raw_image.h"
+#include "simulated_pairs.h"
 #include "source_tree.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
@@ -58,31 +59,14 @@ constexpr double kCameraFps = 30.0;
 // A recorder graph holds a second of frames (docs/mcap.md, "Recording live").
 constexpr int kRecorderFramesInFlight = 30;
 
-struct FramePair {
-  std::shared_ptr<const RawTofFrame> raw;
-  std::shared_ptr<const ColorImage> color;
-};
+using FramePair = testing::SimulatedPair;
 
 StageRegistry& registry();
 
 // Frame pairs of case_c, each with its own noise.
 const std::vector<FramePair>& rendered_pairs() {
-  static const std::vector<FramePair> pairs = [] {
-    json params = {{"calibration", kCalibration}, {"preset", "case_c"}};
-    for (const auto& spec : registry().find("synthetic.scene")->descriptor.params) {
-      if (!params.contains(spec.name)) params[spec.name] = spec.default_value;
-    }
-    StageInstance scene = registry().create(
-        "synthetic.scene", StageContext{"scene", Params(params), Logger("scene"), {}});
-    std::vector<FramePair> rendered;
-    for (int i = 0; i < kRenderedPairs; ++i) {
-      std::vector<Packet> outputs(3);
-      Frame frame(FrameInfo{}, {}, outputs);
-      dynamic_cast<Source&>(*scene.stage).produce(frame);
-      rendered.push_back({outputs[0].share<RawTofFrame>(), outputs[1].share<ColorImage>()});
-    }
-    return rendered;
-  }();
+  static const std::vector<FramePair> pairs =
+      testing::render_pairs(registry(), "case_c", kRenderedPairs);
   return pairs;
 }
 

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "image_folder/png_decoder.h"
 #include "tilth/error.h"
 #include "tilth/regular_file.h"
 
@@ -13,6 +14,7 @@ std::string read_image_bytes(const std::filesystem::path& file) {
 }
 
 cv::Mat decode_image(const std::string& bytes, const std::filesystem::path& file) {
+  if (std::optional<cv::Mat> png = decode_png(bytes, file)) return *std::move(png);
   cv::Mat image;
   if (!bytes.empty()) {
     image = cv::imdecode(

@@ -1,5 +1,5 @@
 // An image file of a recording (a frame's PNG, or a mask to import into one), read safely:
-// a regular file only, within a size limit, decoded unchanged by OpenCV.
+// a regular file only, within a size limit, decoded unchanged as OpenCV decodes it.
 #pragma once
 
 #include <cstdint>
@@ -18,8 +18,9 @@ inline constexpr std::uint64_t kMaxImageBytes = 256 << 20;
 // message (not a regular file, larger than kMaxImageBytes).
 std::string read_image_bytes(const std::filesystem::path& file);
 
-// `bytes` decoded unchanged (a palette PNG comes out as BGR, as OpenCV decodes it).
-// Throws tilth::Error "FILE: not a readable image" when OpenCV cannot decode them.
+// `bytes` decoded unchanged: a recording's kinds of PNG by decode_png, others by OpenCV
+// (a palette PNG comes out as BGR). Throws decode_png's "FILE: damaged PNG: ..." or
+// tilth::Error "FILE: not a readable image" when OpenCV cannot decode them.
 cv::Mat decode_image(const std::string& bytes, const std::filesystem::path& file);
 
 // read_image_bytes, then decode_image.

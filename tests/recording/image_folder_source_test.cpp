@@ -478,14 +478,22 @@ TEST_F(ImageFolderSourceTest, MissingOrUnreadablePngSkipsTheFrameWithAWarning) {
   record(5);
   fs::remove(folder_ / "color/000006.png");
   write_text(folder_ / "depth/000008.png", "not a PNG");
+  // Cut before its last chunk, as a copy that stopped part way leaves a file.
+  const fs::path cut = folder_ / "color/000007.png";
+  const std::uintmax_t cut_size = fs::file_size(cut) - 12;
+  fs::resize_file(cut, cut_size);
   const RunResult result = run(replay_graph(folder_, {{"on_missing", "skip"}}));
   EXPECT_FALSE(result.failed) << result.failure;
-  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4, 7}));
-  EXPECT_EQ(result.metrics.frames_completed, 3u);
+  EXPECT_EQ(captured_ids(), (std::vector<std::uint64_t>{3, 4}));
+  EXPECT_EQ(result.metrics.frames_completed, 2u);
   const auto logged = warnings();
   const std::vector<std::string> expected{
       "src: " + (folder_ / "color/000006.png").string() +
           " (frames.csv line 4): no such file; frame 6 skipped (on_missing: skip)",
+      "src: " + cut.string() +
+          " (frames.csv line 5): damaged PNG: the file ends inside a chunk's header "
+          "(truncated?) at byte " +
+          std::to_string(cut_size) + "; frame 7 skipped (on_missing: skip)",
       "src: " + (folder_ / "depth/000008.png").string() +
           " (frames.csv line 6): not a readable image; frame 8 skipped (on_missing: skip)"};
   EXPECT_EQ(logged, expected);
