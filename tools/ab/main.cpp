@@ -196,11 +196,12 @@ int run(Options options) {
     comparison.jobs.push_back(
         job_result(runs[j], jobs.files[j], jobs.labels[j], options.no_soil_below));
   }
-  write_report(comparison, options.layout, options.overlays);
+  const ReportFigures figures = report_figures(comparison);
+  write_report(comparison, figures, options.layout, options.overlays);
   if (!options.keep_images) {
     for (const auto& files : jobs.files) fs::remove_all(files.images);
   }
-  if (!options.quiet) print_summary(comparison, options.layout);
+  if (!options.quiet) print_summary(comparison, figures, options.layout);
   for (const auto& job : comparison.jobs) {
     if (job.failed) std::cerr << "tilth ab: a graph failed: " << job.failure << "\n";
   }

@@ -174,8 +174,9 @@ int merge(const cli::CommandLine& line, const std::vector<std::string>& argument
   } catch (const Error& error) {
     throw MergeUsageError(std::string("--out ") + error.what());
   }
-  write_report(comparison, options.layout, options.overlays);
-  if (!line.flag("--quiet")) print_summary(comparison, options.layout);
+  const ReportFigures figures = report_figures(comparison);
+  write_report(comparison, figures, options.layout, options.overlays);
+  if (!line.flag("--quiet")) print_summary(comparison, figures, options.layout);
   if (!missing.empty()) {
     std::cerr << "tilth ab merge: " << missing.size() << " of " << comparison.jobs.size()
               << " jobs missing (their shard did not finish: run it again, then merge again):\n";

@@ -5,7 +5,6 @@
 #include <string>
 
 #include "overlays.h"
-#include "paired.h"
 #include "report_html.h"
 #include "report_numbers.h"
 
@@ -21,28 +20,30 @@ std::string column(const std::optional<double>& value, const char* format) {
 
 }  // namespace
 
-void write_report(const Comparison& comparison, const OutputLayout& layout, std::size_t overlays) {
+void write_report(const Comparison& comparison, const ReportFigures& figures,
+                  const OutputLayout& layout, std::size_t overlays) {
   Overlays shown;
   for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
     shown.push_back(disagreement_overlays(comparison, r, overlays));
   }
-  const auto summary = summary_json(comparison, shown);
+  const auto summary = summary_json(comparison, figures, shown);
   write_text(layout.summary_json(), summary.dump(2) + "\n");
-  write_summary_csv(comparison, layout.summary_csv());
-  write_conditions_csv(comparison, layout.conditions_csv());
+  write_summary_csv(comparison, figures, layout.summary_csv());
+  write_conditions_csv(comparison, figures, layout.conditions_csv());
   write_frames_csv(comparison, layout.frames_csv());
-  write_text(layout.report(), report_html(comparison, summary, shown));
+  write_text(layout.report(), report_html(comparison, figures, summary, shown));
 }
 
-void print_summary(const Comparison& comparison, const OutputLayout& layout) {
+void print_summary(const Comparison& comparison, const ReportFigures& figures,
+                   const OutputLayout& layout) {
   std::printf("%-16s %7s %7s %7s %7s %11s %11s %7s  %s\n", "variant", "frames", "valid", "missed",
               "false", "mean|err|", "max|err|", "residue", "against the baseline");
   std::printf("%-16s %7s %7s %7s %7s %11s %11s %7s\n", "", "", "", "", "valid", "mm", "mm", "IoU");
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-    const Figures f = comparison.variant_figures(v);
+    const Figures& f = figures.variants[v].figures;
     const bool errors = f.error.count > 0;
-    const PairedFigures paired = paired_figures(comparison, v);
-    std::string against = distance_verdict(comparison, v, paired);
+    const PairedFigures& paired = figures.variants[v].paired;
+    std::string against = figures.variants[v].verdict;
     if (v != comparison.baseline && paired.abs_error_difference_mm) {
       against += " (" + column(paired.abs_error_difference_mm, "%+.3f") + " mm)";
     }

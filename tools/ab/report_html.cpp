@@ -2,8 +2,6 @@
 
 #include <cstdio>
 
-#include "conditions.h"
-#include "paired.h"
 #include "report_assets.h"
 
 namespace tilth::ab {
@@ -135,11 +133,9 @@ std::string variants_section(const Comparison& comparison) {
   return html + "</table>\n";
 }
 
-std::string summary_section(const Comparison& comparison) {
+std::string summary_section(const Comparison& comparison, const ReportFigures& report) {
   std::vector<Figures> figures;
-  for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-    figures.push_back(comparison.variant_figures(v));
-  }
+  for (const VariantFigures& variant : report.variants) figures.push_back(variant.figures);
   const auto best = best_variant(figures);
   std::string html = "<h2>All recordings</h2>\n<table><tr><th class=\"name\">variant</th>" +
                      std::string(kFiguresHeader) + "</tr>\n";
@@ -167,18 +163,17 @@ const char* kPairedHeader =
     "<th>frames valid, baseline missed</th><th>frames false valid, baseline not</th>"
     "<th>frames not false valid, baseline was</th>";
 
-std::string paired_cells(const Comparison& comparison, std::size_t variant) {
-  const PairedFigures p = paired_figures(comparison, variant);
+std::string paired_cells(const VariantFigures& variant) {
+  const PairedFigures& p = variant.paired;
   return cell(std::to_string(p.frames_with_both_errors)) + cell(std::to_string(p.recordings)) +
          cell(signed_fixed(p.abs_error_difference_mm)) +
-         cell(interval(p.ci95_low_mm, p.ci95_high_mm)) +
-         verdict_cell(distance_verdict(comparison, variant, p)) +
+         cell(interval(p.ci95_low_mm, p.ci95_high_mm)) + verdict_cell(variant.verdict) +
          count_cell(p.missed_by_variant_only) + cell(std::to_string(p.missed_by_baseline_only)) +
          count_cell(p.false_valid_by_variant_only) +
          cell(std::to_string(p.false_valid_by_baseline_only));
 }
 
-std::string baseline_section(const Comparison& comparison) {
+std::string baseline_section(const Comparison& comparison, const ReportFigures& figures) {
   const std::string& baseline = comparison.variants[comparison.baseline].name;
   std::string html =
       "<h2>Against the baseline, " + escape(baseline) +
@@ -192,14 +187,13 @@ std::string baseline_section(const Comparison& comparison) {
       std::string(kPairedHeader) + "</tr>\n";
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
     html += "<tr>" + cell(escape(comparison.variants[v].name), "name") +
-            paired_cells(comparison, v) + "</tr>\n";
+            paired_cells(figures.variants[v]) + "</tr>\n";
   }
   return html + "</table>\n";
 }
 
-std::string conditions_section(const Comparison& comparison) {
-  const auto conditions = conditions_of(comparison);
-  if (conditions.empty()) return "";
+std::string conditions_section(const Comparison& comparison, const ReportFigures& figures) {
+  if (figures.conditions.empty()) return "";
   std::string html =
       "<h2>By condition</h2>\n<p class=\"note\">The figures of the frames in each "
       "condition: residue cover from the truth mask (1 &minus; its soil fraction), and the "
@@ -210,11 +204,10 @@ std::string conditions_section(const Comparison& comparison) {
       "<th>mean |error| (mm)</th><th>max |error| (mm)</th><th>residue IoU</th>"
       "<th>mean |error| difference (mm)</th><th>95% CI over recordings (mm)</th>"
       "<th class=\"name\">distance verdict</th></tr>\n";
-  for (const Condition& condition : conditions) {
-    const Comparison part = restricted_to(comparison, condition);
+  for (const ConditionFigures& condition : figures.conditions) {
     for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-      const Figures f = part.variant_figures(v);
-      const PairedFigures p = paired_figures(part, v);
+      const Figures& f = condition.variants[v].figures;
+      const PairedFigures& p = condition.variants[v].paired;
       html += "<tr>" + cell(escape(condition.name), "name") +
               cell(escape(condition.value), "name") +
               cell(escape(comparison.variants[v].name), "name") + cell(std::to_string(f.frames)) +
@@ -224,7 +217,7 @@ std::string conditions_section(const Comparison& comparison) {
               cell(f.mask ? fixed(f.mask->iou(), 3) : std::string("&ndash;")) +
               cell(signed_fixed(p.abs_error_difference_mm)) +
               cell(interval(p.ci95_low_mm, p.ci95_high_mm)) +
-              verdict_cell(distance_verdict(part, v, p)) + "</tr>\n";
+              verdict_cell(condition.variants[v].verdict) + "</tr>\n";
     }
   }
   return html + "</table>\n";
@@ -252,7 +245,7 @@ std::string stamp_paragraph(const json& made) {
   return html + "</p>\n";
 }
 
-std::string recordings_section(const Comparison& comparison) {
+std::string recordings_section(const Comparison& comparison, const ReportFigures& report) {
   std::string html =
       "<h2>Per recording</h2>\n<table><tr><th class=\"name\">recording</th>"
       "<th class=\"name\">variant</th>" +
@@ -260,7 +253,7 @@ std::string recordings_section(const Comparison& comparison) {
   for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
     std::vector<Figures> figures;
     for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-      figures.push_back(comparison.recording_figures(v, r));
+      figures.push_back(report.recordings[v][r].figures);
     }
     const auto best = best_variant(figures);
     for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
@@ -368,8 +361,8 @@ std::string plot_data(const Comparison& comparison, const json& summary) {
 
 }  // namespace
 
-std::string report_html(const Comparison& comparison, const json& summary,
-                        const Overlays& overlays) {
+std::string report_html(const Comparison& comparison, const ReportFigures& figures,
+                        const json& summary, const Overlays& overlays) {
   std::string names;
   for (const auto& variant : comparison.variants) {
     names += (names.empty() ? "" : " vs ") + variant.name;
@@ -408,8 +401,8 @@ std::string report_html(const Comparison& comparison, const json& summary,
         "before the failure.</b><ul>\n" +
         failures + "</ul></div>\n";
   }
-  html += variants_section(comparison) + summary_section(comparison) +
-          baseline_section(comparison) + conditions_section(comparison);
+  html += variants_section(comparison) + summary_section(comparison, figures) +
+          baseline_section(comparison, figures) + conditions_section(comparison, figures);
   html +=
       "<h2>Distance over time</h2>\n<p class=\"note\">Lines break at frames reported "
       "invalid, which are also marked by ticks at the bottom.</p>\n";
@@ -420,7 +413,7 @@ std::string report_html(const Comparison& comparison, const json& summary,
   html +=
       "<h2>Distance errors</h2>\n<figure class=\"plot\" data-plot=\"histogram\">"
       "<figcaption>error histogram, every recording</figcaption></figure>\n";
-  html += recordings_section(comparison) + stage_times_section(comparison) +
+  html += recordings_section(comparison, figures) + stage_times_section(comparison) +
           overlays_section(comparison, overlays);
   html += "<p id=\"render-status\" class=\"note\">plots not drawn (scripts disabled?)</p>\n";
   html += "<script type=\"application/json\" id=\"ab-data\">" + plot_data(comparison, summary) +

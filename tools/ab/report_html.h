@@ -8,11 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "comparison.h"
+#include "report_figures.h"
 #include "report_numbers.h"
 
 namespace tilth::ab {
 
-std::string report_html(const Comparison& comparison, const nlohmann::ordered_json& summary,
-                        const Overlays& overlays);
+std::string report_html(const Comparison& comparison, const ReportFigures& figures,
+                        const nlohmann::ordered_json& summary, const Overlays& overlays);
 
 }  // namespace tilth::ab

@@ -4,8 +4,6 @@
 #include <ctime>
 #include <fstream>
 
-#include "conditions.h"
-#include "paired.h"
 #include "tilth/error.h"
 #include "tilth/version.h"
 
@@ -64,31 +62,29 @@ json figures_json(const Figures& figures) {
           {"mask", mask}};
 }
 
-json paired_json(const Comparison& comparison, std::size_t variant,
-                 std::optional<std::size_t> recording = std::nullopt) {
-  const PairedFigures paired = paired_figures(comparison, variant, recording);
+json paired_json(const Comparison& comparison, const VariantFigures& figures) {
+  const PairedFigures& paired = figures.paired;
   return {{"baseline", comparison.variants[comparison.baseline].name},
           {"frames_with_both_error_values", paired.frames_with_both_errors},
           {"recordings", paired.recordings},
           {"abs_error_difference_mm", optional_json(paired.abs_error_difference_mm)},
           {"abs_error_difference_ci95_low_mm", optional_json(paired.ci95_low_mm)},
           {"abs_error_difference_ci95_high_mm", optional_json(paired.ci95_high_mm)},
-          {"verdict", distance_verdict(comparison, variant, paired)},
+          {"verdict", figures.verdict},
           {"frames_missed_by_variant_only", paired.missed_by_variant_only},
           {"frames_missed_by_baseline_only", paired.missed_by_baseline_only},
           {"frames_false_valid_by_variant_only", paired.false_valid_by_variant_only},
           {"frames_false_valid_by_baseline_only", paired.false_valid_by_baseline_only}};
 }
 
-json conditions_json(const Comparison& comparison) {
+json conditions_json(const Comparison& comparison, const ReportFigures& figures) {
   json list = json::array();
-  for (const Condition& condition : conditions_of(comparison)) {
-    const Comparison part = restricted_to(comparison, condition);
+  for (const ConditionFigures& condition : figures.conditions) {
     json by_variant = json::array();
     for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
       by_variant.push_back({{"variant", comparison.variants[v].name},
-                            {"figures", figures_json(part.variant_figures(v))},
-                            {"against_baseline", paired_json(part, v)}});
+                            {"figures", figures_json(condition.variants[v].figures)},
+                            {"against_baseline", paired_json(comparison, condition.variants[v])}});
     }
     list.push_back(
         {{"condition", condition.name}, {"value", condition.value}, {"variants", by_variant}});
@@ -163,8 +159,9 @@ constexpr const char* kFigureColumns =
     "frames_missed_by_baseline_only";
 
 // The columns of kFigureColumns, each after a comma.
-std::string figure_fields(const Comparison& comparison, std::size_t variant, const Figures& figures,
-                          const PairedFigures& paired) {
+std::string figure_fields(const Comparison& comparison, const VariantFigures& variant) {
+  const Figures& figures = variant.figures;
+  const PairedFigures& paired = variant.paired;
   const auto& e = figures.error;
   const auto& m = figures.mask;
   const auto if_any = [&](double value) { return e.count > 0 ? number(value) : ""; };
@@ -181,8 +178,7 @@ std::string figure_fields(const Comparison& comparison, std::size_t variant, con
         m ? number(m->precision()) : "", m ? number(m->recall()) : "",
         csv_field(comparison.variants[comparison.baseline].name),
         std::to_string(paired.frames_with_both_errors), number(paired.abs_error_difference_mm),
-        number(paired.ci95_low_mm), number(paired.ci95_high_mm),
-        distance_verdict(comparison, variant, paired),
+        number(paired.ci95_low_mm), number(paired.ci95_high_mm), variant.verdict,
         std::to_string(paired.missed_by_variant_only),
         std::to_string(paired.missed_by_baseline_only)}) {
     row += "," + field;
@@ -191,13 +187,13 @@ std::string figure_fields(const Comparison& comparison, std::size_t variant, con
 }
 
 std::string summary_row(const Comparison& comparison, std::size_t variant,
-                        const std::string& recording, const Figures& figures,
-                        const PairedFigures& paired, const std::vector<StageTime>& stages) {
+                        const std::string& recording, const VariantFigures& figures,
+                        const std::vector<StageTime>& stages) {
   double ms_per_frame = 0.0;
   for (const auto& stage : stages) ms_per_frame += stage.latency.mean_ms;
   return csv_field(comparison.variants[variant].name) + "," + csv_field(recording) +
-         figure_fields(comparison, variant, figures, paired) + "," +
-         (stages.empty() ? "" : number(ms_per_frame)) + "\n";
+         figure_fields(comparison, figures) + "," + (stages.empty() ? "" : number(ms_per_frame)) +
+         "\n";
 }
 
 }  // namespace
@@ -242,26 +238,28 @@ json recordings_json(const std::vector<Recording>& recordings) {
   return list;
 }
 
-json summary_json(const Comparison& comparison, const Overlays& overlays) {
+json summary_json(const Comparison& comparison, const ReportFigures& figures,
+                  const Overlays& overlays) {
   const json variants = variants_json(comparison.variants);
   const json recordings = recordings_json(comparison.recordings);
   json by_variant = json::array();
   json by_recording = json::array();
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
     by_variant.push_back({{"variant", comparison.variants[v].name},
-                          {"figures", figures_json(comparison.variant_figures(v))},
-                          {"against_baseline", paired_json(comparison, v)},
+                          {"figures", figures_json(figures.variants[v].figures)},
+                          {"against_baseline", paired_json(comparison, figures.variants[v])},
                           {"stage_times", stage_times_json(comparison.variant_stage_times(v))}});
     for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
       const JobResult& job = comparison.job(v, r);
-      by_recording.push_back({{"variant", comparison.variants[v].name},
-                              {"recording", comparison.recordings[r].name},
-                              {"failed", job.failed},
-                              {"failure", job.failure},
-                              {"figures", figures_json(comparison.recording_figures(v, r))},
-                              {"against_baseline", paired_json(comparison, v, r)},
-                              {"stage_times", stage_times_json(job.stages)},
-                              {"frames_per_second", job.frames_per_second}});
+      by_recording.push_back(
+          {{"variant", comparison.variants[v].name},
+           {"recording", comparison.recordings[r].name},
+           {"failed", job.failed},
+           {"failure", job.failure},
+           {"figures", figures_json(figures.recordings[v][r].figures)},
+           {"against_baseline", paired_json(comparison, figures.recordings[v][r])},
+           {"stage_times", stage_times_json(job.stages)},
+           {"frames_per_second", job.frames_per_second}});
     }
   }
   json disagreements = json::array();
@@ -281,33 +279,31 @@ json summary_json(const Comparison& comparison, const Overlays& overlays) {
           {"recordings", recordings},
           {"variant_figures", by_variant},
           {"recording_figures", by_recording},
-          {"conditions", conditions_json(comparison)},
+          {"conditions", conditions_json(comparison, figures)},
           {"error_histogram", histogram_json(comparison)},
           {"disagreements", disagreements}};
 }
 
-void write_summary_csv(const Comparison& comparison, const std::filesystem::path& file) {
+void write_summary_csv(const Comparison& comparison, const ReportFigures& figures,
+                       const std::filesystem::path& file) {
   std::string text = "variant,recording," + std::string(kFigureColumns) + ",chain_ms_per_frame\n";
   for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
-    text += summary_row(comparison, v, "*", comparison.variant_figures(v),
-                        paired_figures(comparison, v), comparison.variant_stage_times(v));
+    text += summary_row(comparison, v, "*", figures.variants[v], comparison.variant_stage_times(v));
     for (std::size_t r = 0; r < comparison.recordings.size(); ++r) {
-      text += summary_row(comparison, v, comparison.recordings[r].name,
-                          comparison.recording_figures(v, r), paired_figures(comparison, v, r),
+      text += summary_row(comparison, v, comparison.recordings[r].name, figures.recordings[v][r],
                           comparison.job(v, r).stages);
     }
   }
   write_text(file, text);
 }
 
-void write_conditions_csv(const Comparison& comparison, const std::filesystem::path& file) {
+void write_conditions_csv(const Comparison& comparison, const ReportFigures& figures,
+                          const std::filesystem::path& file) {
   std::string text = "variant,condition,value," + std::string(kFigureColumns) + "\n";
-  for (const Condition& condition : conditions_of(comparison)) {
-    const Comparison part = restricted_to(comparison, condition);
+  for (const ConditionFigures& condition : figures.conditions) {
     for (std::size_t v = 0; v < comparison.variants.size(); ++v) {
       text += csv_field(comparison.variants[v].name) + "," + csv_field(condition.name) + "," +
-              csv_field(condition.value) +
-              figure_fields(part, v, part.variant_figures(v), paired_figures(part, v)) + "\n";
+              csv_field(condition.value) + figure_fields(comparison, condition.variants[v]) + "\n";
     }
   }
   write_text(file, text);
