@@ -25,6 +25,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   # the fuzz targets: clang with libFuzzer and its sanitizer runtimes
   clang libclang-rt-14-dev
+  # the CNN segmenter's training (tilth train-segmenter --model cnn) and its tests
+  python3-torch python3-torchvision python3-onnx python3-pil
   # independent readers in tests
   python3-opencv python3-numpy
   # tilth ab tests: statistics recomputed independently, the report opened in a browser

@@ -2,7 +2,9 @@
 // in ms per frame: segmentation.color_threshold per colour space and dilation, and the
 // variants with their defaults; pixel_classifier with the model that TILTH_BENCH_MODEL
 // names (a file of tilth train-segmenter), skipped without one, on the whole frame and in
-// the middle half the measurement chain segments.
+// the middle half the measurement chain segments; cnn likewise with the ONNX file that
+// TILTH_BENCH_CNN names (tilth train-segmenter --model cnn), one core (cv::setNumThreads(0):
+// OpenCV's dnn runs its layers on this thread alone).
 #include <cstdlib>
 #include <memory>
 #include <vector>
@@ -107,6 +109,24 @@ BENCHMARK_CAPTURE(pixel_classifier, whole, nlohmann::json())
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(pixel_classifier, middle_half, nlohmann::json("middle_half"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void cnn(benchmark::State& state, const nlohmann::json& roi) {
+  const char* model = std::getenv("TILTH_BENCH_CNN");
+  if (model == nullptr) {
+    state.SkipWithError("TILTH_BENCH_CNN names no ONNX file (tilth train-segmenter --model cnn)");
+    return;
+  }
+  cv::setNumThreads(0);
+  testing::TransformHarness stage(describe_cnn(), {{"model", model}, {"roi", roi}});
+  const auto frame = straw_and_soil_frame();
+  for (auto _ : state) benchmark::DoNotOptimize(stage.run(frame));
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK_CAPTURE(cnn, whole, nlohmann::json())->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(cnn, middle_half, nlohmann::json("middle_half"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "residue_output.h"
-#include "soil_surface.h"
+#include "soil_surface/soil_surface.h"
 #include "tilth/plugin.h"
 #include "variants.h"
 

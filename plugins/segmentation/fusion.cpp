@@ -20,7 +20,7 @@
 #include "one_material_notice.h"
 #include "residue_index.h"
 #include "residue_output.h"
-#include "soil_surface.h"
+#include "soil_surface/soil_surface.h"
 #include "tilth/plugin.h"
 #include "variants.h"
 

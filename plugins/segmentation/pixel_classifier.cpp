@@ -59,11 +59,7 @@ StageDescriptor describe_pixel_classifier() {
       ParamSpec::path("model", std::nullopt)
           .describe("model file written by tilth train-segmenter (" +
                     std::string(kClassifierFormat) + ")"),
-      ParamSpec::integer("scored_every_px", kScoredEveryPx)
-          .range(1, kMaxScoredEveryPx)
-          .in_unit("px")
-          .describe("the trees score every n-th pixel of every n-th row, and the pixels "
-                    "between them where those disagree; 1 = every pixel"),
+      scored_every_px_param(),
       dilation_px_param(),
       segmented_roi_param(),
       speckle_px_param(1),

@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pixel_classifier/residue_classifier.h"
 #include "residue_rows.h"
 #include "tilth/error.h"
 
@@ -53,6 +54,15 @@ ParamSpec dilation_px_param() {
       .range(0, 32)
       .in_unit("px")
       .describe("pixels within this distance of residue are residue too; 0 = no dilation");
+}
+
+ParamSpec scored_every_px_param() {
+  return ParamSpec::integer("scored_every_px", kScoredEveryPx)
+      .range(1, kMaxScoredEveryPx)
+      .in_unit("px")
+      .describe(
+          "the trees score every n-th pixel of every n-th row, and the pixels "
+          "between them where those disagree; 1 = every pixel");
 }
 
 ParamSpec speckle_px_param(std::int64_t default_px) {

@@ -35,8 +35,9 @@ void check_residue_inputs(const RegisteredColor& color, const DepthImage& depth)
 ParamSpec dilation_px_param();
 ParamSpec speckle_px_param(std::int64_t default_px);
 ParamSpec min_value_param();
-ParamSpec smoothing_px_param();   // colours averaged over a (2r+1)^2 box first
-ParamSpec segmented_roi_param();  // `roi`, null = the whole image
+ParamSpec smoothing_px_param();     // colours averaged over a (2r+1)^2 box first
+ParamSpec segmented_roi_param();    // `roi`, null = the whole image
+ParamSpec scored_every_px_param();  // the trees' grid (pixel_classifier, self_trained)
 
 // 255 where the colour cannot be used: status not kValid, or every channel below min_value.
 void mark_untrusted_color(const cv::Mat& bgr, const cv::Mat& status, int min_value,

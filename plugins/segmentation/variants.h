@@ -9,7 +9,9 @@ namespace tilth::segmentation {
 StageDescriptor describe_color_index();
 StageDescriptor describe_lab_clusters();
 StageDescriptor describe_pixel_classifier();
+StageDescriptor describe_cnn();
 StageDescriptor describe_depth_aided();
 StageDescriptor describe_fusion();
+StageDescriptor describe_self_trained();
 
 }  // namespace tilth::segmentation

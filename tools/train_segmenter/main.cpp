@@ -1,7 +1,7 @@
 // `tilth train-segmenter` (the tilth-train-segmenter program): trains the classifier of
-// segmentation.pixel_classifier from recordings with ground-truth masks, reports how well
-// it does where it was not trained (other recordings, or held-out frames), and writes the
-// model file.
+// segmentation.pixel_classifier from recordings with ground-truth masks, or from the pixels
+// their depth labels (--labels depth), reports how well it does where it was not trained
+// (other recordings, or held-out frames), and writes the model file.
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -11,16 +11,21 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/core/mat.hpp>
 
+#include "cnn_training.h"
 #include "command_line.h"
 #include "commands.h"
 #include "framework/graph_session.h"
+#include "label_tally.h"
 #include "leave_one_out.h"
 #include "pixel_classifier/classifier_model.h"
 #include "segmenter_training.h"
+#include "soil_surface/depth_labels.h"
 #include "tilth/error.h"
 
 namespace {
@@ -28,9 +33,12 @@ namespace {
 namespace fs = std::filesystem;
 using namespace tilth::cli;
 using tilth::segmentation::ClassifierModel;
+using tilth::segmentation::DepthLabelOptions;
+using tilth::segmentation::DepthLabels;
 using tilth::segmentation::FeatureSet;
 using tilth::segmentation::ResidueClassifier;
 using tilth::train_segmenter::ClassifierOptions;
+using tilth::train_segmenter::LabelTally;
 using tilth::train_segmenter::RegisteredFrame;
 using tilth::train_segmenter::RegisteredFrames;
 using tilth::train_segmenter::Scores;
@@ -41,22 +49,36 @@ constexpr const char* kUsage =
 
 Trains the pixel classifier of segmentation.pixel_classifier (a random forest or boosted
 trees over each pixel's colour and texture features) on recordings with ground-truth
-residue masks, scores it where it was not trained, and writes MODEL (OpenCV YAML;
-.yml.gz compresses it).
+residue masks, or on unlabelled recordings with --labels depth, scores it where it was
+not trained, and writes MODEL (OpenCV YAML; .yml.gz compresses it).
 
 Each RECORDING is an image-folder recording (a folder) or an MCAP file. Frames go
 through depth projection and registration as in graphs/measurement-chain.json, so the
-classifier sees the colours the stage will see; frames without a mask are skipped.
+classifier sees the colours the stage will see.
 
 Scoring: with --test, on those recordings; else, with several RECORDINGs, leave one
 recording out (each scored by a model trained on the others); with one, on every 5th
 frame, held out. IoU, precision and recall of residue per recording and overall (pixels
-pooled); MODEL is then trained on every RECORDING.
+pooled), against the recordings' masks whatever the labels (a recording without one is
+not scored); MODEL is then trained on every RECORDING.
 
   --calibration FILE   a rig calibration overriding the one each recording carries
                        (a warning names what differs; default: each recording's own)
   --out MODEL          the model file to write (required)
   --test RECORDING     score on this recording instead (repeatable)
+  --labels SOURCE      mask (default): each frame's ground-truth mask, frames without
+                       one skipped; depth: the pixels whose depth labels them, residue
+                       standing clearly above the soil surface fitted to the frame's
+                       depth and soil on it, the band between and each class's edge
+                       unlabelled; masks are then read only to score
+  --soil-within-mm MM  depth labels: soil lies within MM of the surface (default 1.5)
+  --residue-above-mm MM
+                       depth labels: residue stands more than MM above it (default 4)
+  --edge-px N          depth labels: neither class within N px of the other or the
+                       band between (default 1)
+  --envelope-px N      depth labels: the surface from the depths' envelope over N px, as
+                       segmentation.depth_aided's envelope_px, for ridges and steps
+                       (default 0: a plane)
   --features SET       texture (default): colour, luminance and its texture at 3
                        scales; colour: the pixel's colour alone
   --classifier KIND    forest (default, cv::ml::RTrees) or boosted (cv::ml::Boost)
@@ -69,9 +91,24 @@ pooled); MODEL is then trained on every RECORDING.
   --scored-every N     score as the stage with scored_every_px N does (default 2: every
                        2nd pixel of every 2nd row, and between them where they disagree)
   --report FILE        the scores as JSON as well
+
+--model cnn trains segmentation.cnn's network instead: a small U-Net (PyTorch, Debian's
+python3-torch) on the same frames and masks, written as MODEL (.onnx) and its sidecar
+MODEL.json (the stage's input preparation), scored by the stage's own code. Options of
+the trees (--features, --classifier, --samples, --trees, --depth, --scored-every) and
+--labels depth are the pixel classifier's.
+  --model KIND         pixel_classifier (default) or cnn
+  --epochs N           cnn: training epochs (default 30)
+  --steps N            cnn: batches of 8 windows per epoch (default 40)
+  --no-leave-one-out   cnn: with several RECORDINGs and no --test, train once and do
+                       not score (each left-out recording costs a training)
 )";
 
 constexpr std::uint64_t kHoldOutEvery = 5;
+
+// The options only --labels depth reads.
+const std::set<std::string> kDepthLabelOptions = {"--soil-within-mm", "--residue-above-mm",
+                                                  "--edge-px", "--envelope-px"};
 
 int usage_error(const std::string& message) {
   std::cerr << "tilth train-segmenter: " << message << "\n\n" << kUsage;
@@ -97,6 +134,29 @@ std::string number(const char* format, double value) {
   return text;
 }
 
+std::string percent(std::uint64_t part, std::uint64_t whole) {
+  return number("%.2f %%", whole == 0 ? 0.0 : 100.0 * part / whole);
+}
+
+// "depth labels 79.9 % of ... they agree with its mask on 99.97 % ..." for one recording.
+std::string tally_text(const LabelTally& tally) {
+  std::string text = "depth labels " + percent(tally.labelled(), tally.pixels) +
+                     " of its pixels with trusted colour (soil " +
+                     percent(tally.soil, tally.pixels) + ", residue " +
+                     percent(tally.residue, tally.pixels) + ")";
+  if (tally.judged == 0) return text + "; it has no mask to compare them with";
+  return text + "; they agree with its mask on " + percent(tally.agreeing, tally.judged) +
+         " of the " + std::to_string(tally.judged) + " pixels both label";
+}
+
+std::string depth_labels_text(const DepthLabelOptions& options) {
+  return "soil within " + number("%g", options.soil_within_mm) + " mm, residue above " +
+         number("%g", options.residue_above_mm) + " mm, edge " + std::to_string(options.edge_px) +
+         " px, " +
+         (options.envelope_px > 0 ? "envelope " + number("%g", options.envelope_px) + " px"
+                                  : std::string("a plane"));
+}
+
 std::string scores_text(const Scores& scores) {
   return "accuracy " + number("%.2f %%", 100 * scores.accuracy()) + ", residue IoU " +
          number("%.2f %%", 100 * scores.residue_iou()) + ", precision " +
@@ -108,8 +168,11 @@ std::string scores_text(const Scores& scores) {
 struct Row {
   std::string recording;
   Scores scores;
+  std::uint64_t scored_frames = 0;  // frames with a mask; 0: the recording is not scored
   std::vector<std::string> trained_on;
 };
+
+constexpr const char* kNoMask = "no mask to score against";
 
 nlohmann::json scores_json(const Scores& scores) {
   return {{"iou", scores.residue_iou()},
@@ -123,8 +186,9 @@ nlohmann::json scores_json(const Scores& scores) {
           {"true_soil", scores.true_soil}};
 }
 
-// The table of rows and the pooled overall; returns the pooled scores.
-Scores print_rows(const std::string& scoring, const std::vector<Row>& rows) {
+// The table of rows and the pooled overall of the scored ones; returns the pooled scores,
+// empty when no row is scored.
+std::optional<Scores> print_rows(const std::string& scoring, const std::vector<Row>& rows) {
   std::size_t width = 7;
   for (const Row& row : rows) width = std::max(width, row.recording.size());
   auto line = [&](const std::string& name, const Scores& scores) {
@@ -133,39 +197,116 @@ Scores print_rows(const std::string& scoring, const std::vector<Row>& rows) {
               << number("%9.3f", scores.precision()) << "  " << number("%6.3f", scores.recall())
               << "  " << number("%8.3f", scores.accuracy()) << "  " << scores.pixels() << "\n";
   };
-  std::cout << scoring << ":\n  recording" << std::string(width - 7, ' ')
+  std::cout << scoring << ":\n  recording" << std::string(width - 5, ' ')
             << "IoU  precision  recall  accuracy  pixels\n";
   Scores overall;
   double iou_sum = 0;
+  std::size_t scored = 0;
   for (const Row& row : rows) {
+    if (row.scored_frames == 0) {
+      std::cout << "  " << row.recording << std::string(width - row.recording.size() + 2, ' ')
+                << kNoMask << "\n";
+      continue;
+    }
     line(row.recording, row.scores);
     overall += row.scores;
     iou_sum += row.scores.residue_iou();
+    ++scored;
+  }
+  if (scored == 0) {
+    std::cout << "  nothing scored: no recording has a mask\n";
+    return std::nullopt;
   }
   line("overall", overall);
-  std::cout << "  mean IoU of the recordings: "
-            << number("%.3f", iou_sum / static_cast<double>(rows.size())) << "\n";
+  std::cout << "  mean IoU of the recordings scored (" << scored << " of " << rows.size()
+            << "): " << number("%.3f", iou_sum / static_cast<double>(scored)) << "\n";
   return overall;
 }
 
+// A row not scored has "scored": false and no scores; with none scored, "overall" and
+// "mean_iou" are null.
 void write_report(const fs::path& file, const std::string& scoring, const std::vector<Row>& rows,
-                  const Scores& overall, const nlohmann::json& settings) {
+                  const std::optional<Scores>& overall, const nlohmann::json& settings) {
   nlohmann::json report = settings;
   report["scoring"] = scoring;
   report["recordings"] = nlohmann::json::array();
   double iou_sum = 0;
+  std::size_t scored = 0;
   for (const Row& row : rows) {
-    nlohmann::json entry = scores_json(row.scores);
+    nlohmann::json entry =
+        row.scored_frames == 0 ? nlohmann::json::object() : scores_json(row.scores);
     entry["recording"] = row.recording;
+    entry["scored"] = row.scored_frames != 0;
     entry["trained_on"] = row.trained_on;
     report["recordings"].push_back(entry);
-    iou_sum += row.scores.residue_iou();
+    if (row.scored_frames != 0) {
+      iou_sum += row.scores.residue_iou();
+      ++scored;
+    }
   }
-  report["overall"] = scores_json(overall);
-  report["mean_iou"] = iou_sum / static_cast<double>(rows.size());
+  report["overall"] = overall ? scores_json(*overall) : nlohmann::json();
+  report["mean_iou"] =
+      scored == 0 ? nlohmann::json() : nlohmann::json(iou_sum / static_cast<double>(scored));
   std::ofstream out(file);
   out << report.dump(2) << "\n";
   if (!out) throw tilth::Error("report '" + file.string() + "' cannot be written");
+}
+
+// tilth train-segmenter --model cnn.
+int train_cnn_command(const CommandLine& line) {
+  tilth::train_segmenter::CnnOptions options;
+  try {
+    for (const std::string option : {"--features", "--classifier", "--samples", "--trees",
+                                     "--depth", "--scored-every", "--labels"}) {
+      if (line.value(option)) throw tilth::Error(option + " is an option of the pixel classifier");
+    }
+    for (const std::string& option : kDepthLabelOptions) {
+      if (line.value(option)) throw tilth::Error(option + " is an option of --labels depth");
+    }
+    options.seed =
+        line.count("--seed", 1, std::numeric_limits<std::uint32_t>::max()).value_or(options.seed);
+    options.epochs = static_cast<int>(line.count("--epochs", 1, 10'000).value_or(options.epochs));
+    options.steps = static_cast<int>(line.count("--steps", 1, 100'000).value_or(options.steps));
+    options.leave_one_out = !line.flag("--no-leave-one-out");
+  } catch (const tilth::Error& error) {
+    return usage_error(error.what());
+  }
+  const fs::path calibration = line.value("--calibration").value_or("");
+  const fs::path out = *line.value("--out");
+  try {
+    const auto registry = tilth::load_plugins(".");
+    const tilth::train_segmenter::CnnTraining training = tilth::train_segmenter::train_cnn(
+        line.positional(), line.values("--test"),
+        [&](const std::string& recording) {
+          return open_recording(*registry, recording, calibration);
+        },
+        options, out);
+    std::vector<Row> rows;
+    for (const auto& row : training.rows) {
+      rows.push_back({row.recording, row.scores, row.scored_frames, row.trained_on});
+    }
+    std::optional<Scores> overall;
+    if (rows.empty()) {
+      std::cout << training.scoring << "\n";
+    } else {
+      overall = print_rows(training.scoring, rows);
+    }
+    if (const auto report = line.value("--report")) {
+      write_report(*report, training.scoring, rows, overall,
+                   {{"format", "tilth-train-segmenter-report/1"},
+                    {"model", "cnn"},
+                    {"labels", "mask"},
+                    {"epochs", options.epochs},
+                    {"steps", options.steps},
+                    {"seed", options.seed}});
+    }
+    std::cout << out.string() << " and " << tilth::segmentation::cnn_sidecar_path(out).string()
+              << ": written\n";
+    return kExitOk;
+  } catch (const std::exception& error) {
+    std::cerr << "tilth train-segmenter: " << error.what() << "\n";
+    return kExitFailed;
+  }
 }
 
 }  // namespace
@@ -173,11 +314,13 @@ void write_report(const fs::path& file, const std::string& scoring, const std::v
 int main(int argc, char** argv) {
   std::optional<CommandLine> parsed;
   try {
-    parsed.emplace(argc, argv, 1,
-                   std::set<std::string>{"--calibration", "--out", "--test", "--samples", "--seed",
-                                         "--trees", "--depth", "--features", "--classifier",
-                                         "--report", "--scored-every"},
-                   std::set<std::string>{"--help"});
+    parsed.emplace(
+        argc, argv, 1,
+        std::set<std::string>{"--calibration", "--out", "--test", "--samples", "--seed", "--trees",
+                              "--depth", "--features", "--classifier", "--report", "--scored-every",
+                              "--labels", "--soil-within-mm", "--residue-above-mm", "--edge-px",
+                              "--envelope-px", "--model", "--epochs", "--steps"},
+        std::set<std::string>{"--help", "--no-leave-one-out"});
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
   }
@@ -188,11 +331,44 @@ int main(int argc, char** argv) {
   }
   if (line.positional().empty()) return usage_error("expected at least one RECORDING");
   if (!line.value("--out")) return usage_error("--out MODEL is required");
+  const std::string model_kind = line.value("--model").value_or("pixel_classifier");
+  if (model_kind == "cnn") return train_cnn_command(line);
+  if (model_kind != "pixel_classifier") {
+    return usage_error("--model \"" + model_kind + "\" (expected pixel_classifier or cnn)");
+  }
+  for (const std::string option : {"--epochs", "--steps", "--no-leave-one-out"}) {
+    if (line.value(option) || line.flag(option)) {
+      return usage_error(option + " is an option of --model cnn");
+    }
+  }
   std::uint64_t samples = 0, seed = 0;
   int scored_every_px = tilth::segmentation::kScoredEveryPx;
   ClassifierOptions options;
   FeatureSet features = FeatureSet::kTexture;
+  // Measured on the simulator (docs/segmentation-variants.md, --labels depth): 1.5 mm is
+  // three standard deviations of the 3x3-median ToF noise at 500 mm, 4 mm leaves 2.5 mm
+  // between the classes, and a 1 px edge drops the straws' mixed edge pixels.
+  DepthLabelOptions depth_options{1.5, 4.0, 1, 0.0};
+  std::optional<DepthLabels> labeller;
   try {
+    const std::string labels = line.value("--labels").value_or("mask");
+    if (labels != "mask" && labels != "depth") {
+      throw tilth::Error("--labels \"" + labels + "\" (expected mask or depth)");
+    }
+    for (const std::string& option : kDepthLabelOptions) {
+      if (labels != "depth" && line.value(option)) {
+        throw tilth::Error(option + " is an option of --labels depth (labels: " + labels + ")");
+      }
+    }
+    depth_options.soil_within_mm =
+        line.real("--soil-within-mm", 0.1, 50).value_or(depth_options.soil_within_mm);
+    depth_options.residue_above_mm =
+        line.real("--residue-above-mm", 0.2, 500).value_or(depth_options.residue_above_mm);
+    depth_options.edge_px =
+        static_cast<int>(line.count("--edge-px", 0, 20).value_or(depth_options.edge_px));
+    depth_options.envelope_px =
+        line.real("--envelope-px", 0, 400).value_or(depth_options.envelope_px);
+    if (labels == "depth") labeller.emplace(depth_options);
     features = tilth::segmentation::feature_set_named(line.value("--features").value_or("texture"));
     options.kind =
         tilth::segmentation::classifier_kind_named(line.value("--classifier").value_or("forest"));
@@ -223,31 +399,55 @@ int main(int argc, char** argv) {
     std::vector<TrainingSet> sets;
     std::vector<RegisteredFrame> held_out;
     std::uint64_t draw = 0;
+    cv::Mat labels;
     for (const std::string& recording : recordings) {
       sets.emplace_back(features);
       RegisteredFrames frames = open_recording(*registry, recording, calibration);
       std::uint64_t used = 0, kept_out = 0, unlabelled = 0, position = 0;
+      LabelTally tally;
       while (auto frame = frames.next()) {
-        if (frame->truth->residue_mask.empty()) {
+        if (!labeller && frame->truth->residue_mask.empty()) {
           ++unlabelled;
         } else if (hold_out_frames && position++ % kHoldOutEvery == kHoldOutEvery - 1) {
           held_out.push_back(std::move(*frame));
           ++kept_out;
+        } else if (labeller) {
+          labeller->label(frame->depth->mm, labels);
+          tally += tilth::train_segmenter::tally_labels(labels, *frame);
+          sets.back().sample(*frame, labels, static_cast<std::size_t>(samples),
+                             seed * 1'000'003 + draw++);
+          ++used;
         } else {
           sets.back().sample(*frame, static_cast<std::size_t>(samples), seed * 1'000'003 + draw++);
           ++used;
         }
       }
+      if (labeller && tally.labelled() == 0) {
+        throw tilth::Error(
+            "recording '" + recording + "': depth labels no pixel of its " + std::to_string(used) +
+            " training frames (" + std::to_string(tally.pixels) +
+            " of their pixels have trusted colour; expected pixels with depth, soil within " +
+            number("%g", depth_options.soil_within_mm) +
+            " mm of the surface fitted to it or residue more than " +
+            number("%g", depth_options.residue_above_mm) + " mm above it)");
+      }
       std::cout << recording << ": " << used << " frames for training, " << kept_out
-                << " held out, " << unlabelled << " without a mask\n";
+                << " held out, ";
+      if (labeller) {
+        std::cout << tally_text(tally) << "\n";
+      } else {
+        std::cout << unlabelled << " without a mask\n";
+      }
     }
+    // The scores of a recording and how many of its frames have a mask to score against.
     auto score_recording = [&](const std::string& recording, const ClassifierModel& model) {
       const ResidueClassifier classifier(model, scored_every_px);
       RegisteredFrames frames = open_recording(*registry, recording, calibration);
-      Scores scores;
+      std::pair<Scores, std::uint64_t> scores;
       while (const auto frame = frames.next()) {
         if (const auto scored = tilth::train_segmenter::score_frame(classifier, *frame)) {
-          scores += *scored;
+          scores.first += *scored;
+          ++scores.second;
         }
       }
       return scores;
@@ -260,6 +460,8 @@ int main(int argc, char** argv) {
       sources += (sources.empty() ? "" : ", ") + recordings[i];
     }
     const std::string settings_text =
+        (labeller ? "labelled by depth (" + depth_labels_text(depth_options) + "), "
+                  : std::string("labelled by masks, ")) +
         std::string(tilth::segmentation::feature_set_id(features)) + " features, " +
         std::to_string(options.trees) + " " +
         (options.kind == tilth::segmentation::ClassifierKind::kForest ? "trees" : "boosted trees") +
@@ -273,37 +475,51 @@ int main(int argc, char** argv) {
       if (hold_out_frames) {
         scoring = "held-out frames (every 5th)";
         const ResidueClassifier classifier(model, scored_every_px);
-        Scores scores;
+        Row row{recordings[0] + " (held out)", {}, 0, recordings};
         for (const RegisteredFrame& frame : held_out) {
           if (const auto scored = tilth::train_segmenter::score_frame(classifier, frame)) {
-            scores += *scored;
+            row.scores += *scored;
+            ++row.scored_frames;
           }
         }
-        rows.push_back({recordings[0] + " (held out)", scores, recordings});
+        rows.push_back(row);
       } else {
         scoring = "test recordings";
         for (const std::string& test : tests) {
-          rows.push_back({test, score_recording(test, model), recordings});
+          const auto [scores, scored_frames] = score_recording(test, model);
+          rows.push_back({test, scores, scored_frames, recordings});
         }
       }
     } else {
       scoring = "leave-one-recording-out (each scored by a model trained on the others)";
+      std::vector<std::uint64_t> scored_frames(recordings.size());
       const std::vector<Scores> scores = tilth::train_segmenter::leave_one_recording_out(
           sets, options, [&](std::size_t held, const ClassifierModel& model) {
-            return score_recording(recordings[held], model);
+            const auto [scored, frames] = score_recording(recordings[held], model);
+            scored_frames[held] = frames;
+            return scored;
           });
       for (std::size_t i = 0; i < scores.size(); ++i) {
         std::vector<std::string> others;
         for (std::size_t j = 0; j < recordings.size(); ++j) {
           if (j != i) others.push_back(recordings[j]);
         }
-        rows.push_back({recordings[i], scores[i], others});
+        rows.push_back({recordings[i], scores[i], scored_frames[i], others});
       }
     }
-    const Scores overall = print_rows(scoring, rows);
+    const std::optional<Scores> overall = print_rows(scoring, rows);
     if (const auto report = line.value("--report")) {
+      nlohmann::json depth_labels;  // null: labelled by masks
+      if (labeller) {
+        depth_labels = {{"soil_within_mm", depth_options.soil_within_mm},
+                        {"residue_above_mm", depth_options.residue_above_mm},
+                        {"edge_px", depth_options.edge_px},
+                        {"envelope_px", depth_options.envelope_px}};
+      }
       write_report(*report, scoring, rows, overall,
                    {{"format", "tilth-train-segmenter-report/1"},
+                    {"labels", labeller ? "depth" : "mask"},
+                    {"depth_labels", depth_labels},
                     {"feature_set", tilth::segmentation::feature_set_id(features)},
                     {"classifier", tilth::segmentation::classifier_kind_name(options.kind)},
                     {"trees", options.trees},
@@ -313,10 +529,10 @@ int main(int argc, char** argv) {
                     {"scored_every_px", scored_every_px}});
     }
 
-    ClassifierModel model =
-        all.train(options, "trained on " + sources + " (" + std::to_string(all.soil()) +
-                               " soil and " + std::to_string(all.residue()) + " residue pixels, " +
-                               settings_text + "); " + scoring + ": " + scores_text(overall));
+    ClassifierModel model = all.train(
+        options, "trained on " + sources + " (" + std::to_string(all.soil()) + " soil and " +
+                     std::to_string(all.residue()) + " residue pixels, " + settings_text + "); " +
+                     scoring + ": " + (overall ? scores_text(*overall) : kNoMask));
     tilth::segmentation::write_classifier_model(out, model);
     std::cout << model.training << "\n" << out.string() << ": written\n";
     return kExitOk;

@@ -1,55 +1,37 @@
-// Training segmentation.pixel_classifier's trees from frames with ground-truth masks:
-// pixels sampled per frame and class, the classifier, and its scores on labelled frames.
-// Only pixels whose colour is trusted and whose truth is soil or residue (not mixed)
-// take part.
+// Training segmentation.pixel_classifier's trees from a recording's labelled frames (their
+// ground-truth masks, or labels made from their depth), with the library's training set
+// (pixel_classifier/training_set.h), and the classifier's scores on frames with a mask.
+// Only pixels whose colour is trusted and whose label is soil or residue (not mixed, not
+// unlabelled) take part.
 #pragma once
 
-#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include <opencv2/core/mat.hpp>
 
 #include "pixel_classifier/classifier_model.h"
 #include "pixel_classifier/residue_classifier.h"
+#include "pixel_classifier/training_set.h"
 #include "registered_frames.h"
 
 namespace tilth::train_segmenter {
 
-struct ClassifierOptions {
-  segmentation::ClassifierKind kind = segmentation::ClassifierKind::kForest;
-  int trees = 5;           // trees of a forest, weak trees of boosting
-  int depth = 6;           // deepest level of a tree
-  std::uint64_t seed = 1;  // of OpenCV's draws (bootstrap samples, features tried per split)
-};
+using ClassifierOptions = segmentation::ClassifierOptions;
 
-class TrainingSet {
+// The library's training set, fed with registered frames.
+class TrainingSet : public segmentation::TrainingSet {
  public:
-  explicit TrainingSet(segmentation::FeatureSet features) : features_(features) {}
+  using segmentation::TrainingSet::TrainingSet;
 
-  // Adds up to `per_class` pixels of each class of the frame, drawn with `seed` (the same
-  // seed, the same pixels). Returns false when the frame has no ground-truth mask.
+  // Adds up to `per_class` pixels of each class of the frame's ground-truth mask, drawn
+  // with `seed` (the same seed, the same pixels). Returns false when it has no mask.
   bool sample(const RegisteredFrame& frame, std::size_t per_class, std::uint64_t seed);
-  // Adds another set's samples (of the same feature set).
-  void add(const TrainingSet& other);
-
-  segmentation::FeatureSet features() const { return features_; }
-  std::size_t soil() const { return counts_[0]; }
-  std::size_t residue() const { return counts_[1]; }
-
-  // The classifier of `options` on the samples, the classes weighted equally (each sample
-  // by all samples / (2 x its class's samples)). Throws tilth::Error when a class has no
-  // samples.
-  segmentation::ClassifierModel train(const ClassifierOptions& options,
-                                      const std::string& training) const;
-
- private:
-  segmentation::FeatureSet features_;
-  cv::Mat samples_;  // one row of features per sample
-  std::vector<std::int32_t> labels_;
-  std::array<std::size_t, 2> counts_{};
+  // The same with `labels` (CV_8UC1, ResidueMask values, the frame's size) for the mask.
+  void sample(const RegisteredFrame& frame, const cv::Mat& labels, std::size_t per_class,
+              std::uint64_t seed);
 };
 
 // Pixel counts of a classifier's decisions against the truth.
@@ -63,6 +45,10 @@ struct Scores {
   double recall() const;       // of the residue pixels, the share called residue
   Scores& operator+=(const Scores& other);
 };
+
+// A residue mask's scores (non-zero: residue) against the truth over the trusted pixels
+// (non-zero) where the truth is soil or residue.
+Scores score_mask(const cv::Mat& residue, const cv::Mat& truth, const cv::Mat& trusted);
 
 // The classifier's scores on a frame; empty when the frame has no ground-truth mask.
 std::optional<Scores> score_frame(const segmentation::ResidueClassifier& classifier,
