@@ -299,11 +299,16 @@ class Loader {
 
   // Beside the including file; failing that, among the graphs Tilth ships, so that a
   // machine's graph copied to /etc/tilth/ still includes cameras.json and the chain.
+  // A name the file system refuses (too long, say) is not there: loading it then says so.
   static fs::path included_file(const fs::path& dir, const std::string& name) {
+    const auto exists = [](const fs::path& file) {
+      std::error_code error;
+      return fs::exists(file, error);
+    };
     const fs::path beside = dir / name;
-    if (fs::exists(beside) || fs::path(name).is_absolute()) return beside;
+    if (exists(beside) || fs::path(name).is_absolute()) return beside;
     const fs::path shipped = shipped_data_dir() / "graphs" / name;
-    return fs::exists(shipped) ? shipped : beside;
+    return exists(shipped) ? shipped : beside;
   }
 
   void load_nodes(const json& document, const Location& root, const fs::path& dir,
