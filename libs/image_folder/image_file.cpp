@@ -9,7 +9,10 @@
 namespace tilth::recording {
 
 std::string read_image_bytes(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw Error(file.string() + ": no such file");
+  std::error_code error;  // a name the file system refuses (too long) is an error, not a throw
+  if (!std::filesystem::exists(file, error)) {
+    throw Error(file.string() + ": " + (error ? error.message() : "no such file"));
+  }
   return read_regular_file(file, kMaxImageBytes, "PNG image");
 }
 

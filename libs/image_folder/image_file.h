@@ -14,8 +14,9 @@ namespace tilth::recording {
 // for PNG's worst case; a larger file is not a frame of a recording.
 inline constexpr std::uint64_t kMaxImageBytes = 256 << 20;
 
-// The file's bytes. Throws tilth::Error "FILE: no such file", or read_regular_file's
-// message (not a regular file, larger than kMaxImageBytes).
+// The file's bytes. Throws tilth::Error "FILE: no such file", the file system's reason
+// ("File name too long"), or read_regular_file's message (not a regular file, larger than
+// kMaxImageBytes).
 std::string read_image_bytes(const std::filesystem::path& file);
 
 // `bytes` decoded unchanged: a recording's kinds of PNG by decode_png, others by OpenCV

@@ -126,6 +126,17 @@ TEST(ReadImageFile, DecodesUnchangedAndNamesTheFileInErrors) {
         }
       },
       Error);
+  const auto too_long = dir.path() / (std::string(300, 'x') + ".png");
+  EXPECT_THROW(
+      {
+        try {
+          read_image_file(too_long);
+        } catch (const Error& error) {
+          EXPECT_EQ(std::string(error.what()), too_long.string() + ": File name too long");
+          throw;
+        }
+      },
+      Error);
   const auto text = dir.write("text.png", "not a PNG");
   EXPECT_THROW(
       {
