@@ -12,8 +12,8 @@
 
 namespace tilth::lens {
 
-// OpenCV's distortion on normalised coordinates. T is a scalar or a SIMD vector type
-// (cv::v_float32x4), hence the constants 1 and 2 as members.
+// OpenCV's distortion on normalised coordinates. T is a scalar or a GCC vector type
+// (the registration's kernels), hence the constants 1 and 2 as members.
 template <class T>
 struct Distortion {
   T k1, k2, p1, p2, k3;

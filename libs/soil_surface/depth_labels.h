@@ -9,11 +9,14 @@
 
 namespace tilth::segmentation {
 
+// The defaults were measured on the simulator (docs/segmentation-variants.md, labels from
+// depth): 1.5 mm is three standard deviations of the 3x3-median ToF noise at 500 mm, 4 mm
+// leaves 2.5 mm between the classes, and a 1 px edge drops the straws' mixed edge pixels.
 struct DepthLabelOptions {
-  double soil_within_mm;    // soil: no more than this above or below the surface
-  double residue_above_mm;  // residue: more than this above it
-  int edge_px;              // neither within this many pixels of the other or the band
-  double envelope_px;       // the soil surface's (SoilSurface): 0 a plane, else the envelope
+  double soil_within_mm = 1.5;    // soil: no more than this above or below the surface
+  double residue_above_mm = 4.0;  // residue: more than this above it
+  int edge_px = 1;                // neither within this many pixels of the other or the band
+  double envelope_px = 0.0;       // the soil surface's (SoilSurface): 0 a plane, else the envelope
 };
 
 class DepthLabels {

@@ -4,17 +4,18 @@
 //                                            factor = 1                       (z)
 // with (x', y') the undistorted normalised coordinates of pixel (u, v). The factor
 // depends on the calibration only, so it is an image computed once in the constructor
-// and a frame costs two multiply-adds per pixel, four pixels at a time. Gray 0 (no
+// and a frame costs two multiply-adds per pixel, eight pixels at a time. Gray 0 (no
 // measurement) and gray at or above `saturated_gray` (the sensor's ceiling: saturated, or
 // beyond its range) -> NaN: neither says where the surface is.
 #include "projection.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 
 #include <opencv2/core.hpp>
-#include <opencv2/core/hal/intrin.hpp>
 
 #include "camera_geometry/lens_model.h"
 #include "tilth/calibration.h"
@@ -27,6 +28,14 @@
 
 namespace tilth::depth {
 namespace {
+
+// Eight pixels at a time in GCC vector extensions: eight grays (16 bytes) widened to
+// floats, then computed as two vectors of four, which fit an SSE2 register. (GCC splits
+// wider vectors' arithmetic into registers, but their comparisons into single lanes.)
+constexpr int kLanes = 8;
+using Grays = std::uint16_t __attribute__((vector_size(kLanes * sizeof(std::uint16_t))));
+using EightFloats = float __attribute__((vector_size(kLanes * sizeof(float))));
+using Floats = float __attribute__((vector_size(4 * sizeof(float))));
 
 cv::Mat range_to_depth_factor(const DepthCameraCalibration& camera, const std::string& file) {
   if (camera.depth_measure == DepthMeasure::kZ) {
@@ -86,18 +95,24 @@ class DepthProjection final : public Transform {
                  ? kNoDepth
                  : (static_cast<float>(gray) * scale + offset) * factor - z_offset;
     };
-    using cv::v_float32x4;
-    const v_float32x4 scale4 = cv::v_setall_f32(scale);
-    const v_float32x4 offset4 = cv::v_setall_f32(offset);
-    const v_float32x4 minus_z_offset4 = cv::v_setall_f32(-z_offset);
-    const v_float32x4 no_depth4 = cv::v_setall_f32(kNoDepth);
-    const v_float32x4 zero4 = cv::v_setall_f32(0.0f);
-    const v_float32x4 saturated4 = cv::v_setall_f32(saturated_gray_);
-    const auto project4 = [&](const cv::v_uint32x4& gray, const float* factor) {
-      const v_float32x4 g = cv::v_cvt_f32(cv::v_reinterpret_as_s32(gray));
-      const v_float32x4 z =
-          cv::v_muladd(cv::v_muladd(g, scale4, offset4), cv::v_load(factor), minus_z_offset4);
-      return cv::v_select((g == zero4) | (g >= saturated4), no_depth4, z);
+    const Floats scale4 = Floats{} + scale;
+    const Floats offset4 = Floats{} + offset;
+    const Floats z_offset4 = Floats{} + z_offset;
+    const Floats saturated4 = Floats{} + static_cast<float>(saturated_gray_);
+    const Floats no_depth4 = Floats{} + kNoDepth;
+    const auto project4 = [=](const Floats& g, const float* factor4, float* z4) {
+      Floats factors;
+      std::memcpy(&factors, factor4, sizeof factors);
+      const Floats z = (g * scale4 + offset4) * factors - z_offset4;
+      const Floats out = (g == Floats{}) | (g >= saturated4) ? no_depth4 : z;
+      std::memcpy(z4, &out, sizeof out);
+    };
+    const auto project8 = [=](const std::uint16_t* gray8, const float* factor8, float* z8) {
+      Grays grays;
+      std::memcpy(&grays, gray8, sizeof grays);
+      const EightFloats g = __builtin_convertvector(grays, EightFloats);
+      project4(__builtin_shufflevector(g, g, 0, 1, 2, 3), factor8, z8);
+      project4(__builtin_shufflevector(g, g, 4, 5, 6, 7), factor8 + 4, z8 + 4);
     };
 
     auto depth = pool_.acquire();
@@ -111,13 +126,7 @@ class DepthProjection final : public Transform {
       const auto* factor = used->derived.factor.ptr<float>(v);
       auto* z = depth->mm.ptr<float>(v);
       int u = 0;
-      for (; u + 8 <= cols; u += 8) {  // eight 16-bit gray values, as two sets of four floats
-        cv::v_uint32x4 low;
-        cv::v_uint32x4 high;
-        cv::v_expand(cv::v_load(gray + u), low, high);
-        cv::v_store(z + u, project4(low, factor + u));
-        cv::v_store(z + u + 4, project4(high, factor + u + 4));
-      }
+      for (; u + kLanes <= cols; u += kLanes) project8(gray + u, factor + u, z + u);
       for (; u < cols; ++u) z[u] = project(gray[u], factor[u]);
     }
     frame.set_output(0, std::move(depth));

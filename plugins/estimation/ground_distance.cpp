@@ -21,8 +21,6 @@
 #include <span>
 #include <vector>
 
-#include <opencv2/core/hal/intrin.hpp>
-
 #include "estimators.h"
 #include "plausibility.h"
 #include "rank_selection.h"
@@ -47,17 +45,35 @@ float deviation(float depth_mm, double median_mm) {
   return static_cast<float>(std::abs(depth_mm - median_mm));
 }
 
-// Each depth replaced by deviation(depth, median_mm), two at a time in double precision.
+// Each depth replaced by deviation(depth, median_mm).
 void replace_by_deviations(std::span<float> depths, double median_mm) {
-  const cv::v_float64x2 median = cv::v_setall_f64(median_mm);
-  std::size_t i = 0;
-  for (; i + 4 <= depths.size(); i += 4) {
-    const cv::v_float32x4 four = cv::v_load(depths.data() + i);
-    const cv::v_float64x2 low = cv::v_abs(cv::v_cvt_f64(four) - median);
-    const cv::v_float64x2 high = cv::v_abs(cv::v_cvt_f64_high(four) - median);
-    cv::v_store(depths.data() + i, cv::v_cvt_f32(low, high));
+  for (float& depth : depths) depth = deviation(depth, median_mm);
+}
+
+// Where the finite depths collected so far end, and their range.
+struct FiniteDepths {
+  float* end;
+  float lowest;
+  float highest;
+};
+
+// A row's finite depths stored from found.end on, each depth stored and the end moved on
+// past the finite ones, without a branch per depth. By value and restrict, so that the
+// range stays in registers while the depths are stored.
+[[gnu::noinline]] FiniteDepths collect_finite_row(const float* __restrict depth, int width,
+                                                  FiniteDepths found) {
+  float* __restrict out = found.end;
+  float lowest = found.lowest;
+  float highest = found.highest;
+  for (int col = 0; col < width; ++col) {
+    const float value = depth[col];
+    const bool finite = std::abs(value) <= kLargest;  // NaN, inf: false
+    *out = value;
+    out += finite ? 1 : 0;
+    lowest = finite && value < lowest ? value : lowest;
+    highest = finite && value > highest ? value : highest;
   }
-  for (; i < depths.size(); ++i) depths[i] = deviation(depths[i], median_mm);
+  return {out, lowest, highest};
 }
 
 // The mean of what is left after dropping `trim_fraction` of the indexed values at each end.
@@ -125,49 +141,20 @@ class GroundDistanceEstimator final : public Transform {
     float highest;
   };
 
-  // The region's finite depths, in order, and their range, four at a time: soil and
-  // residue come in patches, so four depths are mostly all finite (stored whole) or none,
-  // and a mixed four go one at a time.
+  // The region's finite depths, in order, and their range.
   static SoilDepths collect_finite(const cv::Mat& depth_mm, const cv::Rect& roi,
                                    std::vector<float>& depths) {
-    // Never shrunk, so no frame after the first allocates or clears it.
-    const auto slots = static_cast<std::size_t>(roi.area());
+    // Never shrunk, so no frame after the first allocates or clears it; one slot more
+    // for the store after the last finite depth.
+    const auto slots = static_cast<std::size_t>(roi.area()) + 1;
     if (depths.size() < slots) depths.resize(slots);
-    float* out = depths.data();
-    const cv::v_float32x4 largest = cv::v_setall_f32(kLargest);
-    cv::v_float32x4 low = largest;
-    cv::v_float32x4 high = cv::v_setall_f32(-kLargest);
-    float lowest = kLargest;
-    float highest = -kLargest;
+    FiniteDepths found{depths.data(), kLargest, -kLargest};
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
-      const float* depth = depth_mm.ptr<float>(row) + roi.x;
-      int col = 0;
-      for (; col + 4 <= roi.width; col += 4) {
-        const cv::v_float32x4 four = cv::v_load(depth + col);
-        const cv::v_float32x4 finite = cv::v_abs(four) <= largest;  // NaN, inf: false
-        low = cv::v_select(finite, cv::v_min(four, low), low);
-        high = cv::v_select(finite, cv::v_max(four, high), high);
-        const int lanes = cv::v_signmask(finite);
-        if (lanes == 0xF) {
-          cv::v_store(out, four);
-          out += 4;
-        } else if (lanes != 0) {
-          for (int lane = 0; lane < 4; ++lane) {
-            if ((lanes >> lane) & 1) *out++ = depth[col + lane];
-          }
-        }
-      }
-      for (; col < roi.width; ++col) {
-        const float value = depth[col];
-        if (!(std::abs(value) <= kLargest)) continue;
-        *out++ = value;
-        lowest = std::min(lowest, value);
-        highest = std::max(highest, value);
-      }
+      found = collect_finite_row(depth_mm.ptr<float>(row) + roi.x, roi.width, found);
     }
-    lowest = std::min(lowest, cv::v_reduce_min(low));
-    highest = std::max(highest, cv::v_reduce_max(high));
-    return {{depths.data(), static_cast<std::size_t>(out - depths.data())}, lowest, highest};
+    return {{depths.data(), static_cast<std::size_t>(found.end - depths.data())},
+            found.lowest,
+            found.highest};
   }
 
   // The trimmed mean, the median and the spread from one histogram of the depths and one

@@ -4,34 +4,19 @@
 #include <numeric>
 #include <utility>
 
-#include <opencv2/core/hal/intrin.hpp>
-
 namespace tilth::estimation {
 namespace {
 
 // Fine enough that a bin holds a small share of a frame's soil depths, small enough that
 // the counts stay in the L1 cache.
 constexpr std::size_t kBins = 4096;
-constexpr int kLanes = 4;  // cv::v_float32x4
 
 std::pair<float, float> range(std::span<const float> values) {
-  std::size_t i = 0;
   float lowest = values[0];
   float highest = values[0];
-  if (values.size() >= kLanes) {
-    cv::v_float32x4 low = cv::v_load(values.data());
-    cv::v_float32x4 high = low;
-    for (i = kLanes; i + kLanes <= values.size(); i += kLanes) {
-      const cv::v_float32x4 value = cv::v_load(values.data() + i);
-      low = cv::v_min(low, value);
-      high = cv::v_max(high, value);
-    }
-    lowest = cv::v_reduce_min(low);
-    highest = cv::v_reduce_max(high);
-  }
-  for (; i < values.size(); ++i) {
-    lowest = std::min(lowest, values[i]);
-    highest = std::max(highest, values[i]);
+  for (const float value : values) {
+    lowest = std::min(lowest, value);
+    highest = std::max(highest, value);
   }
   return {lowest, highest};
 }
@@ -65,23 +50,13 @@ void RankSelection::index(std::span<const float> values, float lowest, float hig
     return static_cast<std::uint16_t>(std::min((value - lowest) * scale, last_bin));
   };
   std::uint16_t* const bins = bin_of_value_.data();
-  std::size_t i = 0;
-  const cv::v_float32x4 low = cv::v_setall_f32(lowest);
-  const cv::v_float32x4 factor = cv::v_setall_f32(scale);
-  const cv::v_float32x4 last = cv::v_setall_f32(last_bin);
-  const auto bins_of = [&](std::size_t first) {
-    return cv::v_trunc(cv::v_min((cv::v_load(values.data() + first) - low) * factor, last));
-  };
-  for (; i + 2 * kLanes <= count; i += 2 * kLanes) {
-    const cv::v_int16x8 eight = cv::v_pack(bins_of(i), bins_of(i + kLanes));  // < 4096: exact
-    cv::v_store(bins + i, cv::v_reinterpret_as_u16(eight));
-  }
-  for (; i < count; ++i) bins[i] = bin_of(values[i]);
+  for (std::size_t i = 0; i < count; ++i) bins[i] = bin_of(values[i]);
   // Two histograms, the values in turn, so that a run of values in one bin does not wait
   // for each increment before the next. Through local pointers, which no store changes.
   std::uint32_t* const counts = counts_.data();
   std::uint32_t* const other_counts = counts + kBins;
-  for (i = 0; i + 2 <= count; i += 2) {
+  std::size_t i = 0;
+  for (; i + 2 <= count; i += 2) {
     ++counts[bins[i]];
     ++other_counts[bins[i + 1]];
   }
@@ -97,25 +72,29 @@ std::size_t RankSelection::bin_of_rank(std::size_t k) const {
 }
 
 void RankSelection::gather_bins(std::size_t first, std::size_t last) {
-  // Eight values' bins are compared at once; only groups with one in the bins are
+  // Groups of eight values are tested at once; only groups with one in the bins are
   // gathered, without a branch per value: each is stored, and the count moves on past
   // those in the bins. One slot more for the last store.
   candidates_.resize(below_bin_[last + 1] - below_bin_[first] + 1);
   const std::uint16_t* bins = bin_of_value_.data();
   const auto lowest = static_cast<std::uint16_t>(first);
   const auto span = static_cast<std::uint16_t>(last - first);
-  const cv::v_uint16x8 lowest8 = cv::v_setall_u16(lowest);
-  const cv::v_uint16x8 span8 = cv::v_setall_u16(span);
+  const auto in_bins = [&](std::size_t i) {
+    return static_cast<std::uint16_t>(bins[i] - lowest) <= span;
+  };
   std::size_t count = 0;
   const auto gather = [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       candidates_[count] = values_[i];
-      count += static_cast<std::uint16_t>(bins[i] - lowest) <= span ? 1 : 0;
+      count += in_bins(i) ? 1 : 0;
     }
   };
+  constexpr std::size_t kGroup = 8;
   std::size_t i = 0;
-  for (; i + 8 <= values_.size(); i += 8) {
-    if (cv::v_check_any(cv::v_sub_wrap(cv::v_load(bins + i), lowest8) <= span8)) gather(i, i + 8);
+  for (; i + kGroup <= values_.size(); i += kGroup) {
+    bool any = false;
+    for (std::size_t j = i; j < i + kGroup; ++j) any |= in_bins(j);
+    if (any) gather(i, i + kGroup);
   }
   gather(i, values_.size());
 }

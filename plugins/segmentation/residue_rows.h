@@ -1,5 +1,5 @@
 // The residue segmentation's per-pixel tests, 64 pixels at a time as the bits
-// of one BitMask word (pixel i of the run is bit i), SIMD where the test allows it.
+// of one BitMask word (pixel i of the run is bit i), sixteen at a time.
 #pragma once
 
 #include <cstdint>

@@ -195,6 +195,8 @@ class TrainingThread {
   std::thread thread_;  // last: starts once the rest exists
 };
 
+constexpr DepthLabelOptions kDepthLabelDefaults;
+
 DepthLabelOptions depth_label_options(const Params& params) {
   return {params.number("soil_within_mm"), params.number("residue_above_mm"),
           static_cast<int>(params.integer("edge_px")), params.number("envelope_px")};
@@ -305,16 +307,16 @@ StageDescriptor describe_self_trained() {
       ParamSpec::integer("depth", 8)
           .range(1, TreeEnsemble::kMaxDepth)
           .describe("deepest level of a tree"),
-      ParamSpec::number("soil_within_mm", 1.5)
+      ParamSpec::number("soil_within_mm", kDepthLabelDefaults.soil_within_mm)
           .range(0.1, 50)
           .in_unit("mm")
           .describe("depth labels: soil lies within this of the fitted soil surface"),
-      ParamSpec::number("residue_above_mm", 4.0)
+      ParamSpec::number("residue_above_mm", kDepthLabelDefaults.residue_above_mm)
           .range(0.2, 500)
           .in_unit("mm")
           .describe("depth labels: residue stands more than this above it (more than "
                     "soil_within_mm: the band between is not labelled)"),
-      ParamSpec::integer("edge_px", 1)
+      ParamSpec::integer("edge_px", kDepthLabelDefaults.edge_px)
           .range(0, 20)
           .in_unit("px")
           .describe("depth labels: no label within this of the other class or the band"),

@@ -345,10 +345,7 @@ int main(int argc, char** argv) {
   int scored_every_px = tilth::segmentation::kScoredEveryPx;
   ClassifierOptions options;
   FeatureSet features = FeatureSet::kTexture;
-  // Measured on the simulator (docs/segmentation-variants.md, --labels depth): 1.5 mm is
-  // three standard deviations of the 3x3-median ToF noise at 500 mm, 4 mm leaves 2.5 mm
-  // between the classes, and a 1 px edge drops the straws' mixed edge pixels.
-  DepthLabelOptions depth_options{1.5, 4.0, 1, 0.0};
+  DepthLabelOptions depth_options;
   std::optional<DepthLabels> labeller;
   try {
     const std::string labels = line.value("--labels").value_or("mask");
