@@ -16,6 +16,7 @@
 
 #include "child_process.h"
 #include "framework/install_layout.h"
+#include "label_tally.h"
 #include "tilth/error.h"
 #include "tilth/messages/residue_mask.h"
 
@@ -52,12 +53,12 @@ class TemporaryFolder {
   fs::path path_;
 };
 
-// NNNNNN.color.png (the registered colour) and NNNNNN.labels.png (the truth, 128 where
-// the colour is not trusted), as train_cnn.py reads them.
-void write_frame(const RegisteredFrame& frame, const fs::path& folder, std::size_t index) {
+// NNNNNN.color.png (the registered colour) and NNNNNN.labels.png (`labels`: the truth or
+// depth labels, 128 where the colour is not trusted), as train_cnn.py reads them.
+void write_frame(const RegisteredFrame& frame, cv::Mat labels, const fs::path& folder,
+                 std::size_t index) {
   char name[32];
   std::snprintf(name, sizeof name, "%06zu", index);
-  cv::Mat labels = frame.truth->residue_mask.clone();
   labels.setTo(ResidueMask::kUnknown, frame.color->status != RegisteredColor::kValid);
   const fs::path colour = folder / (std::string(name) + ".color.png");
   if (!cv::imwrite(colour.string(), frame.color->bgr) ||
@@ -170,28 +171,43 @@ CnnTraining train_cnn(const std::vector<std::string>& recordings,
   }
   const TemporaryFolder temporary;
   const bool hold_out_frames = tests.empty() && recordings.size() == 1;
+  std::optional<segmentation::DepthLabels> labeller;
+  if (options.depth_labels) labeller.emplace(*options.depth_labels);
   std::vector<fs::path> folders;
   std::vector<RegisteredFrame> held_out;
+  cv::Mat labels;
   for (std::size_t i = 0; i < recordings.size(); ++i) {
     folders.push_back(temporary.path() / std::to_string(i));
     fs::create_directory(folders.back());
     RegisteredFrames frames = open(recordings[i]);
     std::size_t written = 0, position = 0, unlabelled = 0;
+    LabelTally tally;
     while (auto frame = frames.next()) {
-      if (frame->truth->residue_mask.empty()) {
+      if (!labeller && frame->truth->residue_mask.empty()) {
         ++unlabelled;
       } else if (hold_out_frames && position++ % kHoldOutEvery == kHoldOutEvery - 1) {
         held_out.push_back(std::move(*frame));
+      } else if (labeller) {
+        labeller->label(frame->depth->mm, labels);
+        tally += tally_labels(labels, *frame);
+        write_frame(*frame, labels, folders.back(), written++);
       } else {
-        write_frame(*frame, folders.back(), written++);
+        write_frame(*frame, frame->truth->residue_mask.clone(), folders.back(), written++);
       }
+    }
+    if (labeller && tally.labelled() == 0) {
+      throw Error("recording '" + recordings[i] + "': depth labels no pixel of its " +
+                  std::to_string(written) + " training frames (" +
+                  depth_labels_text(*options.depth_labels) + ")");
     }
     if (written == 0) {
       throw Error("recording '" + recordings[i] + "': no frame with a mask to train on (" +
                   std::to_string(unlabelled) + " without one; --model cnn trains on masks)");
     }
     std::cout << recordings[i] << ": " << written << " frames for training, " << held_out.size()
-              << " held out, " << unlabelled << " without a mask\n";
+              << " held out, "
+              << (labeller ? tally_text(tally) : std::to_string(unlabelled) + " without a mask")
+              << "\n";
   }
 
   CnnTraining training;
@@ -199,7 +215,9 @@ CnnTraining train_cnn(const std::vector<std::string>& recordings,
     RegisteredFrames frames = open(recording);
     return score_frames(net, [&] { return frames.next(); });
   };
-  const std::string sources = "trained on " + joined(recordings);
+  const std::string sources =
+      "trained on " + joined(recordings) +
+      (labeller ? " labelled by depth (" + depth_labels_text(*options.depth_labels) + ")" : "");
   if (!tests.empty() || hold_out_frames) {
     run_training(folders, out, options, sources);
     segmentation::ResidueNet net(out);

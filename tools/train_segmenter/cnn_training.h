@@ -8,12 +8,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cnn_model/residue_net.h"
 #include "registered_frames.h"
 #include "segmenter_training.h"
+#include "soil_surface/depth_labels.h"
 
 namespace tilth::train_segmenter {
 
@@ -22,6 +24,9 @@ struct CnnOptions {
   int epochs = 30;
   int steps = 40;  // batches of 8 windows per epoch
   bool leave_one_out = true;
+  // Train on labels from depth (segmentation::DepthLabels) instead of the masks; the
+  // masks then only score.
+  std::optional<segmentation::DepthLabelOptions> depth_labels;
 };
 
 // One recording's scores, as the pixel classifier's report has them.
@@ -42,8 +47,8 @@ using OpenRecording = std::function<RegisteredFrames(const std::string& recordin
 // Trains on `recordings` and writes `out` (MODEL.onnx and MODEL.json). Scored on `tests`
 // if any; else with one recording on its every 5th frame, held out; else leave one
 // recording out unless options.leave_one_out is false. Throws tilth::Error naming what
-// failed: no frame with a mask, the Python training (its last lines; exit code 3: PyTorch
-// missing), a model the stage cannot run.
+// failed: no frame with a mask (or, labelled by depth, no pixel labelled), the Python training (its
+// last lines; exit code 3: PyTorch missing), a model the stage cannot run.
 CnnTraining train_cnn(const std::vector<std::string>& recordings,
                       const std::vector<std::string>& tests, const OpenRecording& open,
                       const CnnOptions& options, const std::filesystem::path& out);

@@ -1,5 +1,7 @@
 #include "label_tally.h"
 
+#include <cstdio>
+
 #include "tilth/messages/residue_mask.h"
 
 namespace tilth::train_segmenter {
@@ -7,6 +9,16 @@ namespace {
 
 double ratio(std::uint64_t part, std::uint64_t whole) {
   return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+}
+
+std::string formatted(const char* format, double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+std::string percent(std::uint64_t part, std::uint64_t whole) {
+  return formatted("%.2f %%", 100.0 * ratio(part, whole));
 }
 
 }  // namespace
@@ -44,6 +56,24 @@ LabelTally tally_labels(const cv::Mat& labels, const RegisteredFrame& frame) {
     }
   }
   return tally;
+}
+
+std::string tally_text(const LabelTally& tally) {
+  std::string text = "depth labels " + percent(tally.labelled(), tally.pixels) +
+                     " of its pixels with trusted colour (soil " +
+                     percent(tally.soil, tally.pixels) + ", residue " +
+                     percent(tally.residue, tally.pixels) + ")";
+  if (tally.judged == 0) return text + "; it has no mask to compare them with";
+  return text + "; they agree with its mask on " + percent(tally.agreeing, tally.judged) +
+         " of the " + std::to_string(tally.judged) + " pixels both label";
+}
+
+std::string depth_labels_text(const segmentation::DepthLabelOptions& options) {
+  return "soil within " + formatted("%g", options.soil_within_mm) + " mm, residue above " +
+         formatted("%g", options.residue_above_mm) + " mm, edge " +
+         std::to_string(options.edge_px) + " px, " +
+         (options.envelope_px > 0 ? "envelope " + formatted("%g", options.envelope_px) + " px"
+                                  : std::string("a plane"));
 }
 
 }  // namespace tilth::train_segmenter

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include <opencv2/core/mat.hpp>
 
 #include "registered_frames.h"
+#include "soil_surface/depth_labels.h"
 
 namespace tilth::train_segmenter {
 
@@ -27,5 +29,12 @@ struct LabelTally {
 // `labels` (CV_8UC1, ResidueMask values) of `frame`, counted on its trusted pixels; judged
 // is 0 when the frame has no mask.
 LabelTally tally_labels(const cv::Mat& labels, const RegisteredFrame& frame);
+
+// "depth labels 79.90 % of its pixels ... they agree with its mask on 99.97 % ..." for one
+// recording.
+std::string tally_text(const LabelTally& tally);
+
+// "soil within 1.5 mm, residue above 4 mm, edge 1 px, a plane": the labels' settings.
+std::string depth_labels_text(const segmentation::DepthLabelOptions& options);
 
 }  // namespace tilth::train_segmenter

@@ -38,10 +38,12 @@ using tilth::segmentation::DepthLabels;
 using tilth::segmentation::FeatureSet;
 using tilth::segmentation::ResidueClassifier;
 using tilth::train_segmenter::ClassifierOptions;
+using tilth::train_segmenter::depth_labels_text;
 using tilth::train_segmenter::LabelTally;
 using tilth::train_segmenter::RegisteredFrame;
 using tilth::train_segmenter::RegisteredFrames;
 using tilth::train_segmenter::Scores;
+using tilth::train_segmenter::tally_text;
 using tilth::train_segmenter::TrainingSet;
 
 constexpr const char* kUsage =
@@ -93,10 +95,10 @@ not scored); MODEL is then trained on every RECORDING.
   --report FILE        the scores as JSON as well
 
 --model cnn trains segmentation.cnn's network instead: a small U-Net (PyTorch, Debian's
-python3-torch) on the same frames and masks, written as MODEL (.onnx) and its sidecar
-MODEL.json (the stage's input preparation), scored by the stage's own code. Options of
-the trees (--features, --classifier, --samples, --trees, --depth, --scored-every) and
---labels depth are the pixel classifier's.
+python3-torch) on the same frames and masks (or depth labels), written as MODEL (.onnx)
+and its sidecar MODEL.json (the stage's input preparation), scored by the stage's own
+code. The options of the trees (--features, --classifier, --samples, --trees, --depth,
+--scored-every) are the pixel classifier's.
   --model KIND         pixel_classifier (default) or cnn
   --epochs N           cnn: training epochs (default 30)
   --steps N            cnn: batches of 8 windows per epoch (default 40)
@@ -113,6 +115,37 @@ const std::set<std::string> kDepthLabelOptions = {"--soil-within-mm", "--residue
 int usage_error(const std::string& message) {
   std::cerr << "tilth train-segmenter: " << message << "\n\n" << kUsage;
   return kExitUsage;
+}
+
+// --labels and the options of --labels depth: the depth labels' settings, or none for
+// masks. Throws tilth::Error naming an option that does not fit.
+std::optional<DepthLabelOptions> depth_label_options(const CommandLine& line) {
+  const std::string labels = line.value("--labels").value_or("mask");
+  if (labels != "mask" && labels != "depth") {
+    throw tilth::Error("--labels \"" + labels + "\" (expected mask or depth)");
+  }
+  for (const std::string& option : kDepthLabelOptions) {
+    if (labels != "depth" && line.value(option)) {
+      throw tilth::Error(option + " is an option of --labels depth (labels: " + labels + ")");
+    }
+  }
+  if (labels != "depth") return std::nullopt;
+  DepthLabelOptions options;
+  options.soil_within_mm = line.real("--soil-within-mm", 0.1, 50).value_or(options.soil_within_mm);
+  options.residue_above_mm =
+      line.real("--residue-above-mm", 0.2, 500).value_or(options.residue_above_mm);
+  options.edge_px = static_cast<int>(line.count("--edge-px", 0, 20).value_or(options.edge_px));
+  options.envelope_px = line.real("--envelope-px", 0, 400).value_or(options.envelope_px);
+  return options;
+}
+
+// The report's "depth_labels": the settings, or null for masks.
+nlohmann::json depth_labels_json(const std::optional<DepthLabelOptions>& options) {
+  if (!options) return nullptr;
+  return {{"soil_within_mm", options->soil_within_mm},
+          {"residue_above_mm", options->residue_above_mm},
+          {"edge_px", options->edge_px},
+          {"envelope_px", options->envelope_px}};
 }
 
 // The source stage that reads a recording: a folder is an image-folder recording.
@@ -132,29 +165,6 @@ std::string number(const char* format, double value) {
   char text[32];
   std::snprintf(text, sizeof text, format, value);
   return text;
-}
-
-std::string percent(std::uint64_t part, std::uint64_t whole) {
-  return number("%.2f %%", whole == 0 ? 0.0 : 100.0 * part / whole);
-}
-
-// "depth labels 79.9 % of ... they agree with its mask on 99.97 % ..." for one recording.
-std::string tally_text(const LabelTally& tally) {
-  std::string text = "depth labels " + percent(tally.labelled(), tally.pixels) +
-                     " of its pixels with trusted colour (soil " +
-                     percent(tally.soil, tally.pixels) + ", residue " +
-                     percent(tally.residue, tally.pixels) + ")";
-  if (tally.judged == 0) return text + "; it has no mask to compare them with";
-  return text + "; they agree with its mask on " + percent(tally.agreeing, tally.judged) +
-         " of the " + std::to_string(tally.judged) + " pixels both label";
-}
-
-std::string depth_labels_text(const DepthLabelOptions& options) {
-  return "soil within " + number("%g", options.soil_within_mm) + " mm, residue above " +
-         number("%g", options.residue_above_mm) + " mm, edge " + std::to_string(options.edge_px) +
-         " px, " +
-         (options.envelope_px > 0 ? "envelope " + number("%g", options.envelope_px) + " px"
-                                  : std::string("a plane"));
 }
 
 std::string scores_text(const Scores& scores) {
@@ -256,13 +266,11 @@ void write_report(const fs::path& file, const std::string& scoring, const std::v
 int train_cnn_command(const CommandLine& line) {
   tilth::train_segmenter::CnnOptions options;
   try {
-    for (const std::string option : {"--features", "--classifier", "--samples", "--trees",
-                                     "--depth", "--scored-every", "--labels"}) {
+    for (const std::string option :
+         {"--features", "--classifier", "--samples", "--trees", "--depth", "--scored-every"}) {
       if (line.value(option)) throw tilth::Error(option + " is an option of the pixel classifier");
     }
-    for (const std::string& option : kDepthLabelOptions) {
-      if (line.value(option)) throw tilth::Error(option + " is an option of --labels depth");
-    }
+    options.depth_labels = depth_label_options(line);
     options.seed =
         line.count("--seed", 1, std::numeric_limits<std::uint32_t>::max()).value_or(options.seed);
     options.epochs = static_cast<int>(line.count("--epochs", 1, 10'000).value_or(options.epochs));
@@ -295,7 +303,8 @@ int train_cnn_command(const CommandLine& line) {
       write_report(*report, training.scoring, rows, overall,
                    {{"format", "tilth-train-segmenter-report/1"},
                     {"model", "cnn"},
-                    {"labels", "mask"},
+                    {"labels", options.depth_labels ? "depth" : "mask"},
+                    {"depth_labels", depth_labels_json(options.depth_labels)},
                     {"epochs", options.epochs},
                     {"steps", options.steps},
                     {"seed", options.seed}});
@@ -345,27 +354,11 @@ int main(int argc, char** argv) {
   int scored_every_px = tilth::segmentation::kScoredEveryPx;
   ClassifierOptions options;
   FeatureSet features = FeatureSet::kTexture;
-  DepthLabelOptions depth_options;
+  std::optional<DepthLabelOptions> depth_options;
   std::optional<DepthLabels> labeller;
   try {
-    const std::string labels = line.value("--labels").value_or("mask");
-    if (labels != "mask" && labels != "depth") {
-      throw tilth::Error("--labels \"" + labels + "\" (expected mask or depth)");
-    }
-    for (const std::string& option : kDepthLabelOptions) {
-      if (labels != "depth" && line.value(option)) {
-        throw tilth::Error(option + " is an option of --labels depth (labels: " + labels + ")");
-      }
-    }
-    depth_options.soil_within_mm =
-        line.real("--soil-within-mm", 0.1, 50).value_or(depth_options.soil_within_mm);
-    depth_options.residue_above_mm =
-        line.real("--residue-above-mm", 0.2, 500).value_or(depth_options.residue_above_mm);
-    depth_options.edge_px =
-        static_cast<int>(line.count("--edge-px", 0, 20).value_or(depth_options.edge_px));
-    depth_options.envelope_px =
-        line.real("--envelope-px", 0, 400).value_or(depth_options.envelope_px);
-    if (labels == "depth") labeller.emplace(depth_options);
+    depth_options = depth_label_options(line);
+    if (depth_options) labeller.emplace(*depth_options);
     features = tilth::segmentation::feature_set_named(line.value("--features").value_or("texture"));
     options.kind =
         tilth::segmentation::classifier_kind_named(line.value("--classifier").value_or("forest"));
@@ -424,9 +417,9 @@ int main(int argc, char** argv) {
             "recording '" + recording + "': depth labels no pixel of its " + std::to_string(used) +
             " training frames (" + std::to_string(tally.pixels) +
             " of their pixels have trusted colour; expected pixels with depth, soil within " +
-            number("%g", depth_options.soil_within_mm) +
+            number("%g", depth_options->soil_within_mm) +
             " mm of the surface fitted to it or residue more than " +
-            number("%g", depth_options.residue_above_mm) + " mm above it)");
+            number("%g", depth_options->residue_above_mm) + " mm above it)");
       }
       std::cout << recording << ": " << used << " frames for training, " << kept_out
                 << " held out, ";
@@ -457,7 +450,7 @@ int main(int argc, char** argv) {
       sources += (sources.empty() ? "" : ", ") + recordings[i];
     }
     const std::string settings_text =
-        (labeller ? "labelled by depth (" + depth_labels_text(depth_options) + "), "
+        (labeller ? "labelled by depth (" + depth_labels_text(*depth_options) + "), "
                   : std::string("labelled by masks, ")) +
         std::string(tilth::segmentation::feature_set_id(features)) + " features, " +
         std::to_string(options.trees) + " " +
@@ -506,17 +499,10 @@ int main(int argc, char** argv) {
     }
     const std::optional<Scores> overall = print_rows(scoring, rows);
     if (const auto report = line.value("--report")) {
-      nlohmann::json depth_labels;  // null: labelled by masks
-      if (labeller) {
-        depth_labels = {{"soil_within_mm", depth_options.soil_within_mm},
-                        {"residue_above_mm", depth_options.residue_above_mm},
-                        {"edge_px", depth_options.edge_px},
-                        {"envelope_px", depth_options.envelope_px}};
-      }
       write_report(*report, scoring, rows, overall,
                    {{"format", "tilth-train-segmenter-report/1"},
                     {"labels", labeller ? "depth" : "mask"},
-                    {"depth_labels", depth_labels},
+                    {"depth_labels", depth_labels_json(depth_options)},
                     {"feature_set", tilth::segmentation::feature_set_id(features)},
                     {"classifier", tilth::segmentation::classifier_kind_name(options.kind)},
                     {"trees", options.trees},
