@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <set>
+#include <system_error>
 
 #include <boost/dll/shared_library.hpp>
 
@@ -101,7 +102,13 @@ void check_build(const std::string& name, const BuildStamp& plugin) {
 
 void StageRegistry::load(const fs::path& file) {
   const std::string name = file.string();
-  if (!fs::exists(file)) throw Error(name + ": no such plugin library");
+  // A name the file system refuses (over 255 bytes, from a graph's plugin list) is not
+  // there either, and says why.
+  std::error_code refused;
+  if (!fs::exists(file, refused)) {
+    throw Error(name + ": no such plugin library" +
+                (refused ? " (" + refused.message() + ")" : std::string()));
+  }
   auto library = std::make_shared<boost::dll::shared_library>();
   boost::dll::fs::error_code error;
   library->load(file, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local, error);

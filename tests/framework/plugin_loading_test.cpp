@@ -60,6 +60,13 @@ TEST(PluginLoading, MissingFile) {
             (kPlugins / "nowhere" / "tilth_x.so").string() + ": no such plugin library");
 }
 
+TEST(PluginLoading, ANameTheFileSystemRefusesIsMissingAndSaysWhy) {
+  StageRegistry registry;
+  const fs::path file = kPlugins / (std::string(300, 'x') + ".so");
+  EXPECT_EQ(load_error(registry, file),
+            file.string() + ": no such plugin library (File name too long)");
+}
+
 TEST(PluginLoading, NotATilthPlugin) {
   StageRegistry registry;
   EXPECT_EQ(load_error(registry, plugin("not_a_plugin")),

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <iostream>
 #include <mutex>
+#include <optional>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -158,6 +160,22 @@ bool same_residue(const cv::Mat& mask, const cv::Mat& labels) {
   return cv::countNonZero((said != labelled) & known) == 0;
 }
 
+// The counts the stage logs when the stream ends: frames learnt, models trained, frames
+// turned away while the training thread was busy.
+struct FinishCounts {
+  std::string line;
+  int learnt = 0, models = 0, turned_away = 0;
+};
+
+std::optional<FinishCounts> finish_counts(const std::string& log) {
+  static const std::regex kCounts(
+      "(\\d+) frames learnt, (\\d+) models trained; (\\d+) frames to learn came while "
+      "training and were not learnt");
+  std::smatch found;
+  if (!std::regex_search(log, found, kCounts)) return std::nullopt;
+  return FinishCounts{found[0], std::stoi(found[1]), std::stoi(found[2]), std::stoi(found[3])};
+}
+
 // Undilated and not despeckled, so that the mask is the decision itself.
 const json kBare = {{"dilation_px", 0}, {"speckle_px", 0}};
 
@@ -219,6 +237,14 @@ TEST(SelfTrained, TrainsInTheBackground) {
   // Each frame is offered to the training thread, which takes it or is still busy: models
   // are swapped while frames are segmented.
   for (int i = 1; i < 30; ++i) EXPECT_EQ(flat_straw_found(i), kFlatStraw.area()) << "frame " << i;
+  // Every frame was learnt or turned away, but for the one the thread may still hold.
+  stage.finish();
+  const auto counts = finish_counts(log.text());
+  ASSERT_TRUE(counts) << log.text();
+  EXPECT_GE(counts->models, 1);
+  EXPECT_LE(counts->models, counts->learnt);
+  EXPECT_GE(counts->learnt + counts->turned_away, 29);
+  EXPECT_LE(counts->learnt + counts->turned_away, 30);
 }
 
 // Bare soil: the depth labels find no residue, so nothing is trained, the log says so once
@@ -237,6 +263,12 @@ TEST(SelfTrained, AWindowWithoutResidueTrainsNothingAndSaysSoOnce) {
   EXPECT_NE(log.text().find("no model yet: the mask is the depth labels' residue"),
             std::string::npos);
   EXPECT_EQ(log.text().find("model,"), std::string::npos) << log.text();
+  stage.finish();
+  const auto counts = finish_counts(log.text());
+  ASSERT_TRUE(counts) << log.text();
+  EXPECT_EQ(counts->line,
+            "6 frames learnt, 0 models trained; 0 frames to learn came while "
+            "training and were not learnt");
 }
 
 TEST(SelfTrained, RefusesMarginsWithoutABandBetweenSoilAndResidue) {

@@ -13,6 +13,8 @@ import sys
 import tempfile
 import unittest
 
+import onnx
+
 SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
 sys.path.insert(0, SUPPORT)
 from processes import run_bounded  # noqa: E402
@@ -103,6 +105,22 @@ class TrainCnnTest(unittest.TestCase):
               file=sys.stderr)
         self.assertGreater(report["overall"]["iou"], DEPTH_LABELS_IOU)
 
+    def test_the_networks_shape_is_set_from_the_command_line(self):
+        model = os.path.join(self.folder, "small.onnx")
+        result = run_bounded([TILTH, "train-segmenter", self.recordings[0], "--model", "cnn",
+                              "--out", model, "--input", "64x48", "--input-scale", "0.19",
+                              "--channels", "8,16,32", "--epochs", "1", "--steps", "2"],
+                             self.folder, seconds=120)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        with open(model.replace(".onnx", ".json")) as f:
+            sidecar = json.load(f)
+        self.assertEqual((sidecar["input"]["width"], sidecar["input"]["height"]), (64, 48))
+        self.assertAlmostEqual(sidecar["window_scale"], 0.19)
+        # The first convolution's weights: 8 outputs of 3 inputs, 3x3.
+        weights = {t.name: list(t.dims) for t in onnx.load(model).graph.initializer}
+        self.assertIn([8, 3, 3, 3], weights.values())
+        self.assertNotIn([16, 3, 3, 3], weights.values())
+
     def test_errors(self):
         out = os.path.join(self.folder, "e.onnx")
         cases = [
@@ -114,6 +132,14 @@ class TrainCnnTest(unittest.TestCase):
              "--edge-px is an option of --labels depth (labels: mask)"),
             (["--model", "cnn", "--out", out, "--labels", "drawn"],
              "--labels \"drawn\" (expected mask or depth)"),
+            (["--model", "cnn", "--out", out, "--input", "85x64"],
+             "--input '85x64': expected WIDTHxHEIGHT in px, each a multiple of 4 from 8 to 1024"),
+            (["--model", "cnn", "--out", out, "--channels", "16,32"],
+             "--channels '16,32': expected three channel counts from 1 to 512"),
+            (["--model", "cnn", "--out", out, "--input-scale", "9"],
+             "--input-scale: expected a number in [0.02, 1], got '9'"),
+            (["--out", os.path.join(self.folder, "e.yml"), "--input", "84x64"],
+             "--input is an option of --model cnn"),
             (["--model", "convnet", "--out", out],
              "--model \"convnet\" (expected pixel_classifier or cnn)"),
         ]

@@ -22,7 +22,7 @@ Replays each recording through each variant of the measurement chain (one graph 
 variant and recording, several at once, as fast as they go) and compares the variants
 with the recordings' ground truth: distance error, missed and false-valid frames, mask
 IoU / precision / recall, time per stage. Writes DIR/report.html (self-contained),
-summary.json, summary.csv and frames.csv. docs/ab-testing.md explains every figure.
+summary.json, summary.csv, conditions.csv and frames.csv. docs/ab-testing.md explains every figure.
 SIGINT or SIGTERM stops the graphs cleanly and writes no report (exit code 1); a second
 signal exits at once (code 130).
 

@@ -82,6 +82,17 @@ void run_training(const std::vector<fs::path>& folders, const fs::path& out,
   argv.insert(argv.end(), {"--out", out.string(), "--seed", std::to_string(options.seed),
                            "--epochs", std::to_string(options.epochs), "--steps",
                            std::to_string(options.steps), "--training", training});
+  if (options.input) {
+    argv.insert(argv.end(), {"--width", std::to_string(options.input->width), "--height",
+                             std::to_string(options.input->height)});
+  }
+  if (options.input_scale)
+    argv.insert(argv.end(), {"--scale", std::to_string(*options.input_scale)});
+  if (options.channels) {
+    const auto& [a, b, c] = *options.channels;
+    argv.insert(argv.end(), {"--channels", std::to_string(a) + "," + std::to_string(b) + "," +
+                                               std::to_string(c)});
+  }
   const ChildResult result = run_child(argv, "  train_cnn.py: ");
   if (result.exit_code == kExitTorchMissing) {
     throw Error(

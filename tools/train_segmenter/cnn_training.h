@@ -5,12 +5,15 @@
 // stage's own code (ResidueNet) where it was not trained.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <opencv2/core/types.hpp>
 
 #include "cnn_model/residue_net.h"
 #include "registered_frames.h"
@@ -24,6 +27,10 @@ struct CnnOptions {
   int epochs = 30;
   int steps = 40;  // batches of 8 windows per epoch
   bool leave_one_out = true;
+  // The network's shape; unset: train_cnn.py's defaults (84x64 px, 0.25, 16,32,64).
+  std::optional<cv::Size> input;      // px, multiples of 4
+  std::optional<double> input_scale;  // network px per depth px
+  std::optional<std::array<int, 3>> channels;
   // Train on labels from depth (segmentation::DepthLabels) instead of the masks; the
   // masks then only score.
   std::optional<segmentation::DepthLabelOptions> depth_labels;

@@ -2,6 +2,8 @@
 // segmentation.pixel_classifier from recordings with ground-truth masks, or from the pixels
 // their depth labels (--labels depth), reports how well it does where it was not trained
 // (other recordings, or held-out frames), and writes the model file.
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -102,6 +104,11 @@ code. The options of the trees (--features, --classifier, --samples, --trees, --
   --model KIND         pixel_classifier (default) or cnn
   --epochs N           cnn: training epochs (default 30)
   --steps N            cnn: batches of 8 windows per epoch (default 40)
+  --input WxH          cnn: the network's input in px, multiples of 4 (default 84x64);
+                       smaller runs faster
+  --input-scale S      cnn: network px per depth px (default 0.25): the window segmented
+                       at once is W/S x H/S depth px
+  --channels A,B,C     cnn: the U-Net's channels at its three levels (default 16,32,64)
   --no-leave-one-out   cnn: with several RECORDINGs and no --test, train once and do
                        not score (each left-out recording costs a training)
 )";
@@ -146,6 +153,34 @@ nlohmann::json depth_labels_json(const std::optional<DepthLabelOptions>& options
           {"residue_above_mm", options->residue_above_mm},
           {"edge_px", options->edge_px},
           {"envelope_px", options->envelope_px}};
+}
+
+// --input WxH: multiples of 4 (two poolings) from 8 to 1024.
+cv::Size network_input(const std::string& text) {
+  int width = 0, height = 0;
+  char end = 0;
+  const bool parsed = std::sscanf(text.c_str(), "%dx%d%c", &width, &height, &end) == 2;
+  if (!parsed || width % 4 != 0 || height % 4 != 0 || std::min(width, height) < 8 ||
+      std::max(width, height) > 1024) {
+    throw tilth::Error("--input '" + text +
+                       "': expected WIDTHxHEIGHT in px, each a multiple of 4 from 8 to 1024 "
+                       "(the network pools twice), e.g. 84x64");
+  }
+  return {width, height};
+}
+
+// --channels A,B,C: three counts from 1 to 512.
+std::array<int, 3> unet_channels(const std::string& text) {
+  std::array<int, 3> channels{};
+  char end = 0;
+  const bool parsed =
+      std::sscanf(text.c_str(), "%d,%d,%d%c", &channels[0], &channels[1], &channels[2], &end) == 3;
+  if (!parsed || *std::min_element(channels.begin(), channels.end()) < 1 ||
+      *std::max_element(channels.begin(), channels.end()) > 512) {
+    throw tilth::Error("--channels '" + text +
+                       "': expected three channel counts from 1 to 512, e.g. 16,32,64");
+  }
+  return channels;
 }
 
 // The source stage that reads a recording: a folder is an image-folder recording.
@@ -276,6 +311,9 @@ int train_cnn_command(const CommandLine& line) {
     options.epochs = static_cast<int>(line.count("--epochs", 1, 10'000).value_or(options.epochs));
     options.steps = static_cast<int>(line.count("--steps", 1, 100'000).value_or(options.steps));
     options.leave_one_out = !line.flag("--no-leave-one-out");
+    if (const auto input = line.value("--input")) options.input = network_input(*input);
+    options.input_scale = line.real("--input-scale", 0.02, 1);
+    if (const auto channels = line.value("--channels")) options.channels = unet_channels(*channels);
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
   }
@@ -323,13 +361,18 @@ int train_cnn_command(const CommandLine& line) {
 int main(int argc, char** argv) {
   std::optional<CommandLine> parsed;
   try {
-    parsed.emplace(
-        argc, argv, 1,
-        std::set<std::string>{"--calibration", "--out", "--test", "--samples", "--seed", "--trees",
-                              "--depth", "--features", "--classifier", "--report", "--scored-every",
-                              "--labels", "--soil-within-mm", "--residue-above-mm", "--edge-px",
-                              "--envelope-px", "--model", "--epochs", "--steps"},
-        std::set<std::string>{"--help", "--no-leave-one-out"});
+    parsed.emplace(argc, argv, 1, std::set<std::string>{"--calibration",    "--out",
+                                                        "--test",           "--samples",
+                                                        "--seed",           "--trees",
+                                                        "--depth",          "--features",
+                                                        "--classifier",     "--report",
+                                                        "--scored-every",   "--labels",
+                                                        "--soil-within-mm", "--residue-above-mm",
+                                                        "--edge-px",        "--envelope-px",
+                                                        "--model",          "--epochs",
+                                                        "--steps",          "--input",
+                                                        "--input-scale",    "--channels"},
+                   std::set<std::string>{"--help", "--no-leave-one-out"});
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
   }
@@ -345,7 +388,8 @@ int main(int argc, char** argv) {
   if (model_kind != "pixel_classifier") {
     return usage_error("--model \"" + model_kind + "\" (expected pixel_classifier or cnn)");
   }
-  for (const std::string option : {"--epochs", "--steps", "--no-leave-one-out"}) {
+  for (const std::string option :
+       {"--epochs", "--steps", "--no-leave-one-out", "--input", "--input-scale", "--channels"}) {
     if (line.value(option) || line.flag(option)) {
       return usage_error(option + " is an option of --model cnn");
     }

@@ -72,6 +72,10 @@ class TransformHarness {
     return out;
   }
 
+  // The end of the stream, which the runtime signals once after the last frame: where a
+  // stage that keeps state reports or flushes it.
+  void finish() { stage_->finish(); }
+
  private:
   StageDescriptor descriptor_;
   std::unique_ptr<Stage> stage_;
