@@ -77,13 +77,23 @@ std::filesystem::path recording_json_with(const testing::TempDir& dir, const std
   return dir.path();
 }
 
-std::string error_of(const std::filesystem::path& folder) {
+// The message read() throws, or "no error".
+template <typename Read>
+std::string error_of(Read read) {
   try {
-    read_recording_json(folder);
+    read();
   } catch (const Error& error) {
     return error.what();
   }
   return "no error";
+}
+
+std::string recording_error_of(const std::filesystem::path& folder) {
+  return error_of([&] { read_recording_json(folder); });
+}
+
+std::string image_error_of(const std::filesystem::path& file) {
+  return error_of([&] { read_image_file(file); });
 }
 
 TEST(RecordingJson, ReadsTagsAsStrings) {
@@ -99,11 +109,11 @@ TEST(RecordingJson, ReadsTagsAsStrings) {
 TEST(RecordingJson, RefusesTagsThatAreNotStrings) {
   testing::TempDir dir;
   const std::string file = (dir.path() / "recording.json").string();
-  EXPECT_EQ(error_of(recording_json_with(dir, R"(, "tags": ["north"])")),
+  EXPECT_EQ(recording_error_of(recording_json_with(dir, R"(, "tags": ["north"])")),
             file +
                 ":/tags: expected an object of strings, e.g. {\"site\": \"north\"}, got "
                 "[\"north\"]");
-  EXPECT_EQ(error_of(recording_json_with(dir, R"(, "tags": {"rows": 12})")),
+  EXPECT_EQ(recording_error_of(recording_json_with(dir, R"(, "tags": {"rows": 12})")),
             file + ":/tags/rows: expected a string, got 12");
 }
 
@@ -116,38 +126,11 @@ TEST(ReadImageFile, DecodesUnchangedAndNamesTheFileInErrors) {
   EXPECT_EQ(cv::countNonZero(read != gray), 0);
 
   const auto missing = dir.path() / "missing.png";
-  EXPECT_THROW(
-      {
-        try {
-          read_image_file(missing);
-        } catch (const Error& error) {
-          EXPECT_EQ(std::string(error.what()), missing.string() + ": no such file");
-          throw;
-        }
-      },
-      Error);
+  EXPECT_EQ(image_error_of(missing), missing.string() + ": no such file");
   const auto too_long = dir.path() / (std::string(300, 'x') + ".png");
-  EXPECT_THROW(
-      {
-        try {
-          read_image_file(too_long);
-        } catch (const Error& error) {
-          EXPECT_EQ(std::string(error.what()), too_long.string() + ": File name too long");
-          throw;
-        }
-      },
-      Error);
+  EXPECT_EQ(image_error_of(too_long), too_long.string() + ": File name too long");
   const auto text = dir.write("text.png", "not a PNG");
-  EXPECT_THROW(
-      {
-        try {
-          read_image_file(text);
-        } catch (const Error& error) {
-          EXPECT_EQ(std::string(error.what()), text.string() + ": not a readable image");
-          throw;
-        }
-      },
-      Error);
+  EXPECT_EQ(image_error_of(text), text.string() + ": not a readable image");
 }
 
 }  // namespace
