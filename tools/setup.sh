@@ -9,6 +9,8 @@ packages=(
   # framework and SDK
   libtbb-dev nlohmann-json3-dev libboost-dev libboost-filesystem-dev
   libopencv-dev libeigen3-dev
+  # the tools' command lines
+  libcli11-dev
   # cameras (GigE Vision) and the camera simulator used by the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev iproute2
   # tilth doctor's test: packet loss caused in the simulated cameras' network

@@ -1,5 +1,7 @@
 #include "command_line.h"
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <charconv>
 #include <sstream>
 
@@ -27,48 +29,60 @@ template <typename Number>
   throw Error(message.str());
 }
 
+bool looks_like_option(const std::string& arg) {
+  return arg.size() > 1 && arg.front() == '-' && arg != "--";
+}
+
 }  // namespace
 
 CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
                          const std::set<std::string>& flags) {
+  CLI::App app;
+  app.set_help_flag();
+  app.allow_extras();  // positional arguments and unknown options, told apart below
+  std::map<std::string, std::vector<std::string>> given;
+  for (const auto& option : valued) app.add_option(option, given[option])->allow_extra_args(false);
+  for (const auto& option : flags) app.add_flag(option == "--help" ? "-h,--help" : option);
+
+  // A value is whatever follows its option, as a user who writes `--set -x` expects.
+  std::vector<std::string> args;
   for (int i = first; i < argc; ++i) {
-    std::string arg = argv[i];
-    std::optional<std::string> inline_value;
-    if (arg.starts_with("--") && arg.find('=') != std::string::npos && !valued.count(arg)) {
-      const auto equals = arg.find('=');
-      if (valued.count(arg.substr(0, equals))) {
-        inline_value = arg.substr(equals + 1);
-        arg = arg.substr(0, equals);
-      }
-    }
-    if (valued.count(arg)) {
-      if (!inline_value && i + 1 >= argc) throw Error(arg + " needs a value");
-      values_.emplace(arg, inline_value ? *inline_value : argv[++i]);
-    } else if (flags.count(arg)) {
-      flags_.insert(arg);
-    } else if (arg == "-h" && flags.count("--help")) {
-      flags_.insert("--help");
-    } else if (arg.starts_with("-") && arg != "-") {
+    args.emplace_back(argv[i]);
+    if (!valued.count(argv[i])) continue;
+    if (i + 1 == argc) throw Error(args.back() + " needs a value");
+    if (looks_like_option(argv[i + 1])) args.back() += std::string("=") + argv[++i];
+  }
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& error) {
+    throw Error(std::string(error.what()) + " (see --help)");
+  }
+
+  for (const auto& arg : app.remaining()) {
+    if (looks_like_option(arg)) {
       std::vector<std::string> known(valued.begin(), valued.end());
       known.insert(known.end(), flags.begin(), flags.end());
-      throw Error("unknown option " + arg + did_you_mean(arg, known) + " (see --help)");
-    } else {
-      positional_.push_back(arg);
+      const std::string name = arg.substr(0, arg.find('='));
+      throw Error("unknown option " + name + did_you_mean(name, known) + " (see --help)");
     }
+    positional_.push_back(arg);
   }
+  for (auto& [option, values] : given)
+    if (!values.empty()) values_[option] = std::move(values);
+  for (const auto& option : flags)
+    if (app.count(option) > 0) flags_.insert(option);
 }
 
 std::vector<std::string> CommandLine::values(const std::string& option) const {
-  std::vector<std::string> result;
-  auto [begin, end] = values_.equal_range(option);
-  for (auto it = begin; it != end; ++it) result.push_back(it->second);
-  return result;
+  const auto found = values_.find(option);
+  return found == values_.end() ? std::vector<std::string>{} : found->second;
 }
 
 std::optional<std::string> CommandLine::value(const std::string& option) const {
-  auto all = values(option);
-  if (all.empty()) return std::nullopt;
-  return all.back();
+  const auto found = values_.find(option);
+  if (found == values_.end()) return std::nullopt;
+  return found->second.back();
 }
 
 std::optional<std::uint64_t> CommandLine::count(const std::string& option, std::uint64_t min,

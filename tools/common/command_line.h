@@ -1,5 +1,5 @@
-// The options of one `tilth` command, parsed from argv: positional arguments, repeated
-// KEY=VALUE options and flags.
+// The options of one `tilth` command, parsed from argv by CLI11: positional arguments,
+// repeated KEY=VALUE options and flags, with the nearest known names for a misspelt one.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +32,7 @@ class CommandLine {
 
  private:
   std::vector<std::string> positional_;
-  std::multimap<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
   std::set<std::string> flags_;
 };
 

@@ -1,0 +1,107 @@
+// CommandLine: what every tool's arguments become (positional arguments in order, repeated
+// options in order, flags), and the errors a mistyped command line gets.
+#include "command_line.h"
+
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tilth/error.h"
+
+namespace tilth::cli {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+const std::set<std::string> kValued = {"--set", "--frames", "--out"};
+const std::set<std::string> kFlags = {"--help", "--quiet"};
+
+// argv as main() gets it: the program and its command first.
+CommandLine parse(std::initializer_list<const char*> args,
+                  const std::set<std::string>& flags = kFlags) {
+  std::vector<std::string> text = {"tilth", "run"};
+  text.insert(text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& arg : text) argv.push_back(arg.data());
+  return CommandLine(static_cast<int>(argv.size()), argv.data(), 2, kValued, flags);
+}
+
+std::string error_of(std::initializer_list<const char*> args,
+                     const std::set<std::string>& flags = kFlags) {
+  try {
+    parse(args, flags);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(CommandLine, KeepsPositionalArgumentsInTheirOrderAroundOptions) {
+  const auto line = parse({"a.json", "--frames", "5", "b", "--quiet", "-", "c"});
+  EXPECT_THAT(line.positional(), ElementsAre("a.json", "b", "-", "c"));
+  EXPECT_EQ(line.value("--frames"), "5");
+  EXPECT_TRUE(line.flag("--quiet"));
+  EXPECT_FALSE(line.flag("--help"));
+}
+
+TEST(CommandLine, KeepsEveryValueOfARepeatedOptionInOrderAndTheLastAsItsValue) {
+  const auto line = parse({"--set", "a.x=1", "--set=b.y=2", "--set", "c.z=3"});
+  EXPECT_THAT(line.values("--set"), ElementsAre("a.x=1", "b.y=2", "c.z=3"));
+  EXPECT_EQ(line.value("--set"), "c.z=3");
+  EXPECT_TRUE(line.values("--out").empty());
+  EXPECT_EQ(line.value("--out"), std::nullopt);
+}
+
+TEST(CommandLine, TakesWhateverFollowsAValuedOptionAsItsValue) {
+  const auto line = parse({"--out", "-", "--set", "-x=1", "--frames", "--quiet"});
+  EXPECT_EQ(line.value("--out"), "-");
+  EXPECT_EQ(line.value("--set"), "-x=1");
+  EXPECT_EQ(line.value("--frames"), "--quiet");
+  EXPECT_FALSE(line.flag("--quiet"));
+}
+
+TEST(CommandLine, ReadsDashHAsHelpWhereTheCommandHasHelp) {
+  EXPECT_TRUE(parse({"-h"}).flag("--help"));
+  EXPECT_TRUE(parse({"--help"}).flag("--help"));
+  EXPECT_EQ(error_of({"-h"}, {"--quiet"}), "unknown option -h (see --help)");
+}
+
+TEST(CommandLine, NamesAnUnknownOptionAndTheNearestKnownOnes) {
+  EXPECT_EQ(error_of({"--frame", "3"}),
+            "unknown option --frame; did you mean '--frames'? (see --help)");
+  EXPECT_EQ(error_of({"g.json", "--quite"}),
+            "unknown option --quite; did you mean '--quiet'? (see --help)");
+  EXPECT_EQ(error_of({"--sett=a.b=1"}),
+            "unknown option --sett; did you mean '--set'? (see --help)");
+  EXPECT_EQ(error_of({"--zzzzzz"}), "unknown option --zzzzzz (see --help)");
+}
+
+TEST(CommandLine, SaysWhichOptionLacksItsValue) {
+  EXPECT_EQ(error_of({"g.json", "--frames"}), "--frames needs a value");
+  EXPECT_EQ(error_of({"--out"}), "--out needs a value");
+}
+
+TEST(CommandLine, ReadsCountsWholeAndInTheirRange) {
+  EXPECT_EQ(parse({"--frames", "12"}).count("--frames", 1, 100), 12u);
+  EXPECT_EQ(parse({}).count("--frames", 1, 100), std::nullopt);
+  for (const char* bad : {"5abc", "-1", " 5", "5.0", "", "0", "101"})
+    EXPECT_THROW(parse({"--frames", bad}).count("--frames", 1, 100), Error) << bad;
+  try {
+    parse({"--frames", "5abc"}).count("--frames", 1, 100);
+  } catch (const Error& error) {
+    EXPECT_STREQ(error.what(), "--frames: expected a whole number in [1, 100], got '5abc'");
+  }
+}
+
+TEST(CommandLine, ReadsRealsWholeAndInTheirRange) {
+  EXPECT_DOUBLE_EQ(*parse({"--frames", "2.5"}).real("--frames", 0, 10), 2.5);
+  for (const char* bad : {"2.5x", "nan", "11", "-0.1", ""})
+    EXPECT_THROW(parse({"--frames", bad}).real("--frames", 0, 10), Error) << bad;
+}
+
+}  // namespace
+}  // namespace tilth::cli
