@@ -58,9 +58,12 @@ else
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# The independent MCAP reader of the tests (@mcap/core), pinned by package-lock.json.
-reader="$(dirname "$0")/../tests/mcap/js"
-if [ ! -d "$reader/node_modules" ]; then
-  echo "setup: installing the npm packages of $reader"
-  (cd "$reader" && npm ci --no-audit --no-fund --silent)
-fi
+# The npm packages of the tests, pinned by their package-lock.json: the independent MCAP
+# reader (@mcap/core) and the Kubernetes API's schemas (kubernetes-models).
+for folder in tests/mcap/js tests/ab/kubernetes; do
+  folder="$(dirname "$0")/../$folder"
+  if [ ! -d "$folder/node_modules" ]; then
+    echo "setup: installing the npm packages of $folder"
+    (cd "$folder" && npm ci --no-audit --no-fund --silent)
+  fi
+done

@@ -1,8 +1,7 @@
-"""The Kubernetes manifests of deploy/fleet/kubernetes, without a cluster. No JSON schema
-of batch/v1 Job ships in a Debian bookworm package (kubeconform and the Kubernetes
-OpenAPI documents are not packaged), so the files are checked here against the fields
-of the Kubernetes API they use (python3-yaml): each parses; the kinds and apiVersions;
-no unknown key where this test knows the object's fields (a misspelt key would be
+"""The Kubernetes manifests of deploy/fleet/kubernetes, without a cluster, beyond their
+schemas (kubernetes/manifest_schemas.test.mjs validates them against the Kubernetes API's
+own): each parses (python3-yaml); the kinds and apiVersions; no unknown key where this
+test knows the object's fields (the API's schemas allow them, and a misspelt key would be
 dropped or refused by the API server); the shards' Job is Indexed with completions
 equal to the shard count its pods pass to --shard and parallelism at most completions;
 JOB_COMPLETION_INDEX goes to --shard and to the shard's folder; both Jobs mount the
