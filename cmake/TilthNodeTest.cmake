@@ -6,7 +6,7 @@ find_program(NPM npm REQUIRED)
 # tilth_node_test(NAME DIR SCRIPT LABELS...): `node --test SCRIPT` in DIR, after `npm ci`
 # when DIR's node_modules is missing or older than its lock file. The tests of one DIR
 # share a resource lock, so that two never install at once. The environment has
-# TILTH_SOURCE_DIR; set more with set_tests_properties.
+# TILTH_SOURCE_DIR; append more with set_property(TEST ... APPEND PROPERTY ENVIRONMENT).
 function(tilth_node_test name dir script)
   string(MAKE_C_IDENTIFIER "npm_${dir}" lock)
   add_test(NAME ${name}

@@ -60,10 +60,10 @@ fi
 
 # The npm packages of the tests, pinned by their package-lock.json: the independent MCAP
 # reader (@mcap/core) and the Kubernetes API's schemas (kubernetes-models).
-for folder in tests/mcap/js tests/ab/kubernetes; do
-  folder="$(dirname "$0")/../$folder"
-  if [ ! -d "$folder/node_modules" ]; then
-    echo "setup: installing the npm packages of $folder"
-    (cd "$folder" && npm ci --no-audit --no-fund --silent)
+for tests in tests/mcap/js tests/ab/kubernetes; do
+  path="$(dirname "$0")/../$tests"
+  if [ ! -d "$path/node_modules" ]; then
+    echo "setup: installing the npm packages of $tests"
+    (cd "$path" && npm ci --no-audit --no-fund --silent)
   fi
 done

@@ -1,14 +1,17 @@
 // `tilth cameras`: the GigE Vision cameras this host can reach, and one camera's GenICam
 // features. The `tilth` program runs this executable for `tilth cameras ...`.
 #include <algorithm>
-#include <cstring>
 #include <iostream>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "aravis/camera_features.h"
 #include "aravis/device_list.h"
 #include "aravis/gobject_ptr.h"
+#include "command_line.h"
+#include "tilth/error.h"
 
 namespace {
 
@@ -20,6 +23,10 @@ constexpr const char* kUsage =
     "interface (vendor, model, serial number, address, device id).\n"
     "  --features CAMERA   every GenICam feature of one camera: name, type, value, access\n"
     "                      (CAMERA: IPv4 address, serial number, device id or MAC address)\n";
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailed = 1;
+constexpr int kExitUsage = 2;
 
 void print_table(const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::size_t> widths;
@@ -41,7 +48,7 @@ int list_cameras() {
   const std::vector<DeviceEntry> devices = discover_devices();
   if (devices.empty()) {
     std::cout << "no GigE Vision cameras found\n";
-    return 0;
+    return kExitOk;
   }
   std::vector<std::vector<std::string>> rows = {
       {"VENDOR", "MODEL", "SERIAL", "ADDRESS", "DEVICE ID"}};
@@ -49,7 +56,7 @@ int list_cameras() {
     rows.push_back({device.vendor, device.model, device.serial, device.address, device.id});
   }
   print_table(rows);
-  return 0;
+  return kExitOk;
 }
 
 int dump_features(const std::string& name) {
@@ -68,23 +75,35 @@ int dump_features(const std::string& name) {
     }
   }
   print_table(rows);
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::optional<tilth::cli::CommandLine> parsed;
   try {
-    if (argc == 1) return list_cameras();
-    if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
-      std::cout << kUsage;
-      return 0;
-    }
-    if (argc == 3 && std::strcmp(argv[1], "--features") == 0) return dump_features(argv[2]);
-    std::cerr << kUsage;
-    return 2;
+    parsed.emplace(argc, argv, 1, std::set<std::string>{"--features"},
+                   std::set<std::string>{"--help"});
+  } catch (const tilth::Error& error) {
+    std::cerr << "tilth cameras: " << error.what() << "\n" << kUsage;
+    return kExitUsage;
+  }
+  const tilth::cli::CommandLine& line = *parsed;
+  if (line.flag("--help")) {
+    std::cout << kUsage;
+    return kExitOk;
+  }
+  if (!line.positional().empty()) {
+    std::cerr << "tilth cameras: unexpected argument '" << line.positional().front() << "'\n"
+              << kUsage;
+    return kExitUsage;
+  }
+  try {
+    if (const auto camera = line.value("--features")) return dump_features(*camera);
+    return list_cameras();
   } catch (const std::exception& error) {
     std::cerr << "tilth cameras: " << error.what() << "\n";
-    return 1;
+    return kExitFailed;
   }
 }

@@ -1,9 +1,10 @@
 #include "command_line.h"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <charconv>
 #include <sstream>
+
+#include <CLI/CLI.hpp>
 
 #include "framework/nearest_names.h"
 #include "tilth/error.h"
@@ -29,29 +30,55 @@ template <typename Number>
   throw Error(message.str());
 }
 
-bool looks_like_option(const std::string& arg) {
-  return arg.size() > 1 && arg.front() == '-' && arg != "--";
-}
+bool looks_like_option(const std::string& arg) { return arg.size() > 1 && arg.front() == '-'; }
 
 }  // namespace
 
 CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
                          const std::set<std::string>& flags) {
+  std::vector<std::string> known(valued.begin(), valued.end());
+  known.insert(known.end(), flags.begin(), flags.end());
+  const auto unknown = [&known](const std::string& name) {
+    return Error("unknown option " + name + did_you_mean(name, known) + " (see --help)");
+  };
+
+  // What CLI11 reads: each option followed by its value (which CLI11 takes whatever it
+  // looks like, even empty), flags alone, positional arguments; after `--`, only
+  // positional arguments, which CLI11 does not see.
+  std::vector<std::string> args;
+  std::vector<std::string> after_separator;
+  for (int i = first; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") {
+      after_separator.assign(argv + i + 1, argv + argc);
+      break;
+    }
+    const std::string name = arg.substr(0, arg.find('='));
+    if (valued.count(name)) {
+      args.push_back(name);
+      if (name != arg) {
+        args.push_back(arg.substr(name.size() + 1));
+      } else if (i + 1 < argc) {
+        args.push_back(argv[++i]);
+      } else {
+        throw Error(arg + " needs a value");
+      }
+    } else if (flags.count(name) && name != arg) {
+      throw Error(name + " takes no value (see --help)");
+    } else if (arg.starts_with("-") && !arg.starts_with("--") && arg != "-" &&
+               !(arg == "-h" && flags.count("--help"))) {
+      throw unknown(arg);  // CLI11 would read "-hq" as -h and -q
+    } else {
+      args.push_back(arg);
+    }
+  }
+
   CLI::App app;
   app.set_help_flag();
   app.allow_extras();  // positional arguments and unknown options, told apart below
   std::map<std::string, std::vector<std::string>> given;
   for (const auto& option : valued) app.add_option(option, given[option])->allow_extra_args(false);
   for (const auto& option : flags) app.add_flag(option == "--help" ? "-h,--help" : option);
-
-  // A value is whatever follows its option, as a user who writes `--set -x` expects.
-  std::vector<std::string> args;
-  for (int i = first; i < argc; ++i) {
-    args.emplace_back(argv[i]);
-    if (!valued.count(argv[i])) continue;
-    if (i + 1 == argc) throw Error(args.back() + " needs a value");
-    if (looks_like_option(argv[i + 1])) args.back() += std::string("=") + argv[++i];
-  }
   std::reverse(args.begin(), args.end());  // CLI11 takes them last first
   try {
     app.parse(args);
@@ -60,14 +87,10 @@ CommandLine::CommandLine(int argc, char** argv, int first, const std::set<std::s
   }
 
   for (const auto& arg : app.remaining()) {
-    if (looks_like_option(arg)) {
-      std::vector<std::string> known(valued.begin(), valued.end());
-      known.insert(known.end(), flags.begin(), flags.end());
-      const std::string name = arg.substr(0, arg.find('='));
-      throw Error("unknown option " + name + did_you_mean(name, known) + " (see --help)");
-    }
+    if (looks_like_option(arg)) throw unknown(arg.substr(0, arg.find('=')));
     positional_.push_back(arg);
   }
+  positional_.insert(positional_.end(), after_separator.begin(), after_separator.end());
   for (auto& [option, values] : given)
     if (!values.empty()) values_[option] = std::move(values);
   for (const auto& option : flags)

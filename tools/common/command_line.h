@@ -13,9 +13,10 @@ namespace tilth::cli {
 
 class CommandLine {
  public:
-  // `valued` options take the next argument (--set k=v); `flags` take none; -h is --help
-  // where --help is a flag. Throws tilth::Error for an unknown option (with the nearest
-  // known ones) or a missing value.
+  // `valued` options take the next argument, whatever it is (--set k=v), or what follows
+  // their `=` (--set=k=v); `flags` take none; -h is --help where --help is a flag; after
+  // `--` every argument is positional. Throws tilth::Error for an unknown option (with the
+  // nearest known ones), a missing value or a flag given one.
   CommandLine(int argc, char** argv, int first, const std::set<std::string>& valued,
               const std::set<std::string>& flags);
 
