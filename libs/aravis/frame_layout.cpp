@@ -48,8 +48,15 @@ BufferLayout layout_of(ArvBuffer* buffer) {
         part.data_type == ARV_BUFFER_PART_DATA_TYPE_3D_IMAGE ||
         part.data_type == ARV_BUFFER_PART_DATA_TYPE_CONFIDENCE_MAP) {
       part.pixel_format = arv_buffer_get_part_pixel_format(buffer, i);
-      part.width = arv_buffer_get_part_width(buffer, i);
-      part.height = arv_buffer_get_part_height(buffer, i);
+      gint x = 0;
+      gint y = 0;
+      gint width = 0;
+      gint height = 0;
+      arv_buffer_get_part_region(buffer, i, &x, &y, &width, &height);
+      part.x_offset = x;
+      part.y_offset = y;
+      part.width = width;
+      part.height = height;
       gint x_padding = 0;
       gint y_padding = 0;
       arv_buffer_get_part_padding(buffer, i, &x_padding, &y_padding);

@@ -22,6 +22,8 @@ struct PartLayout {
   ArvPixelFormat pixel_format = 0;
   int width = 0;
   int height = 0;
+  int x_offset = 0;  // the image's top-left pixel on the sensor (a region of interest)
+  int y_offset = 0;
   int x_padding = 0;  // bytes after each row
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;  // bytes

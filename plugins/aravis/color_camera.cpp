@@ -27,6 +27,7 @@ class ColorCamera final : public CameraSource {
     buffer.lend_to(color->pixels);
     color->format = *format->color;
     color->device_timestamp_ns = device_timestamp_ns;
+    color->sensor_offset = cv::Point(part.x_offset, part.y_offset);
     frame.set_output(kImage, std::move(color));
   }
 };
@@ -41,8 +42,8 @@ StageDescriptor describe_color_camera() {
       "through losses";
   d.outputs = {
       PortSpec::of<ColorImage>("color",
-                               "the image in the camera's pixel format, no copy; none while "
-                               "the camera is lost"),
+                               "the image in the camera's pixel format, no copy, with its "
+                               "place on the sensor; none while the camera is lost"),
       PortSpec::of<CameraStatus>("status", "streaming, problem and frame counts, every frame"),
   };
   d.params = camera_param_specs(color_formats());

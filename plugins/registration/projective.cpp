@@ -16,6 +16,10 @@
 // the segmentation reads). The z-buffer always holds every depth pixel, so occlusion
 // inside the region is the same as in a whole image.
 //
+// A colour image that is a window of the calibrated image (its camera reads out a region
+// of interest: ColorImage::sensor_offset) is registered with the calibration of that
+// window (with_color_window); depth pixels whose colour lies outside it are kOutsideColor.
+//
 // Occlusion is a z-buffer over the colour image, in cells just large enough that a
 // surface seen by both cameras leaves none empty (OcclusionCells): a first pass keeps the
 // nearest point of each cell, and in the second a point more than occlusion_tolerance_mm
@@ -29,6 +33,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -235,20 +241,31 @@ void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, con
 
 // What registering a frame needs from its calibration.
 struct Geometry {
+  Geometry(const RigCalibration& rig, const RowKernels& kernels)
+      : origin(rig.origin), map(rig, rig.origin, kernels), cells(rig) {}
+
   std::string origin;  // the calibration's, for messages
   DepthToColor map;
   OcclusionCells cells;
 };
 
+// The geometry for colour images that are a window of the calibrated image (a camera's
+// region of interest): made from the calibration with that window, once per calibration
+// and window.
+struct WindowGeometry {
+  std::shared_ptr<const RigCalibration> rig;  // the calibration it was made from
+  cv::Rect window;
+  std::shared_ptr<const Geometry> geometry;
+};
+
 class ProjectiveRegistration final : public Transform {
  public:
   explicit ProjectiveRegistration(const StageContext& context)
-      : calibration_(context.params, context.log,
-                     [&kernels = row_kernels(context.params.string("instruction_set"))](
-                         const RigCalibration& rig) {
-                       return Geometry{rig.origin, DepthToColor(rig, rig.origin, kernels),
-                                       OcclusionCells(rig)};
-                     }),
+      : log_(context.log),
+        kernels_(row_kernels(context.params.string("instruction_set"))),
+        calibration_(
+            context.params, context.log,
+            [&kernels = kernels_](const RigCalibration& rig) { return Geometry(rig, kernels); }),
         occlusion_tolerance_mm_(
             static_cast<float>(context.params.number("occlusion_tolerance_mm"))),
         bilinear_(context.params.string("interpolation") == "bilinear"),
@@ -257,8 +274,8 @@ class ProjectiveRegistration final : public Transform {
   void process(Frame& frame) override {
     const DepthImage& depth = frame.input<DepthImage>(0);
     const ColorImage& color = frame.input<ColorImage>(1);
-    const auto used = calibration_.for_frame(depth.rig);
-    const Geometry& geometry = used->derived;
+    const auto geometry_held = geometry_for(calibration_.for_frame(depth.rig), color);
+    const Geometry& geometry = *geometry_held;
     check(geometry, depth.mm, color);
 
     const DepthToColor& map = geometry.map;
@@ -279,6 +296,27 @@ class ProjectiveRegistration final : public Transform {
   }
 
  private:
+  using Used = FrameCalibration<Geometry>::Used;
+
+  // The calibration's geometry, or its window's when the colour image is a window of the
+  // calibrated image.
+  std::shared_ptr<const Geometry> geometry_for(std::shared_ptr<const Used> used,
+                                               const ColorImage& color) {
+    const RigCalibration& rig = *used->rig;
+    const cv::Rect whole(0, 0, rig.color.width, rig.color.height);
+    if (!color.sensor_offset || cv::Rect(*color.sensor_offset, color.pixels.size()) == whole) {
+      return {used, &used->derived};
+    }
+    const cv::Rect window(*color.sensor_offset, color.pixels.size());
+    std::lock_guard lock(window_mutex_);
+    if (window_.rig != used->rig || window_.window != window) {
+      auto geometry = std::make_shared<const Geometry>(with_color_window(rig, window), kernels_);
+      log_.info("colour images are a window of the sensor: registering with " + geometry->origin);
+      window_ = {used->rig, window, std::move(geometry)};
+    }
+    return window_.geometry;
+  }
+
   // Bilinear sampling blends demosaiced pixels.
   void register_bilinear(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color,
                          Rows rows, Scratch& scratch, RegisteredColor& out) const {
@@ -335,7 +373,11 @@ class ProjectiveRegistration final : public Transform {
     }
   }
 
+  const Logger log_;
+  const RowKernels& kernels_;
   FrameCalibration<Geometry> calibration_;
+  std::mutex window_mutex_;
+  WindowGeometry window_;
   const float occlusion_tolerance_mm_;
   const bool bilinear_;
   const RegionOfInterest roi_;

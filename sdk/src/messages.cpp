@@ -83,7 +83,12 @@ std::string DepthImage::summary() const {
 }
 
 std::string ColorImage::summary() const {
-  return "colour " + size_of(pixels) + " " + std::string(to_string(format));
+  std::string text = "colour " + size_of(pixels) + " " + std::string(to_string(format));
+  if (sensor_offset) {
+    text += " at (" + std::to_string(sensor_offset->x) + ", " + std::to_string(sensor_offset->y) +
+            ") on the sensor";
+  }
+  return text;
 }
 
 std::string RegisteredColor::summary() const {

@@ -395,6 +395,34 @@ TEST(AravisCamera, StreamsMono16AndBayerFromTwoCamerasAt30FramesPerSecondWithout
   expect_every_frame_at_30_fps(color_record, "BayerRG8 (127.0.0.13)");
 }
 
+// A colour camera reading out a region of its sensor says where the region lies (the
+// GigE Vision leader's offsets), so that registration can use the calibration of that
+// window; a whole-sensor image lies at (0, 0).
+TEST(AravisCamera, AColourImageSaysWhereOnTheSensorItLies) {
+  FakeCamera fake("127.0.0.19", "TILTH19");
+  fake.start();
+  {
+    CameraStage whole(describe_color_camera(),
+                      loopback(fake, {{"pixel_format", "BayerRG8"}, {"frame_rate", 30}}));
+    Produced frame = whole.produce();
+    while (!frame.has_image()) frame = whole.produce();
+    EXPECT_EQ(frame.color().pixels.size(), cv::Size(512, 512));  // the simulator's default
+    EXPECT_EQ(frame.color().sensor_offset, cv::Point(0, 0));
+  }
+  CameraStage window(describe_color_camera(),
+                     loopback(fake, {{"pixel_format", "BayerRG8"},
+                                     {"frame_rate", 30},
+                                     {"features", json::array({{{"Width", 704}},
+                                                               {{"Height", 528}},
+                                                               {{"OffsetX", 288}},
+                                                               {{"OffsetY", 248}}})}}));
+  Produced frame = window.produce();
+  while (!frame.has_image()) frame = window.produce();
+  EXPECT_EQ(frame.color().pixels.size(), cv::Size(704, 528));
+  EXPECT_EQ(frame.color().sensor_offset, cv::Point(288, 248));
+  EXPECT_EQ(frame.color().summary(), "colour 704x528 bayer_rggb8 at (288, 248) on the sensor");
+}
+
 TEST(AravisCamera, HeldFramesKeepTheirBuffersAndFramesFindingNoneAreLateNotLost) {
   FakeCamera fake("127.0.0.16", "TILTH16");
   fake.start();

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <span>
 
 #include <gtest/gtest.h>
@@ -85,13 +86,15 @@ std::unique_ptr<Transform> make_registration(const fs::path& calibration,
 
 std::shared_ptr<const RegisteredColor> register_color(
     Transform& stage, const cv::Mat& depth_mm, const cv::Mat& pixels,
-    PixelFormat format = PixelFormat::kBgr8, std::shared_ptr<const RigCalibration> rig = nullptr) {
+    PixelFormat format = PixelFormat::kBgr8, std::shared_ptr<const RigCalibration> rig = nullptr,
+    std::optional<cv::Point> sensor_offset = std::nullopt) {
   DepthImage depth;
   depth.mm = depth_mm;
   depth.rig = std::move(rig);
   ColorImage color;
   color.pixels = pixels;
   color.format = format;
+  color.sensor_offset = sensor_offset;
   const std::vector<Packet> inputs = {
       Packet(FrameInfo{}, std::make_shared<const DepthImage>(std::move(depth))),
       Packet(FrameInfo{}, std::make_shared<const ColorImage>(std::move(color)))};
@@ -550,6 +553,97 @@ TEST(ProjectiveRegistration, ARegionIsRegisteredAsInTheWholeImage) {
   EXPECT_GT(occluded_in_bands, 500);  // the bands hold the case
 }
 
+std::string process_error(Transform& stage, const cv::Mat& depth, const cv::Mat& color,
+                          PixelFormat format,
+                          std::optional<cv::Point> sensor_offset = std::nullopt) {
+  try {
+    register_color(stage, depth, color, format, nullptr, sensor_offset);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "registered";
+}
+
+// A colour camera reading out a window of its sensor: each depth pixel whose colour lies
+// in the window gets the colour it gets from the whole image, the others are outside the
+// colour image. The coordinate image keeps its sensor coordinates when cut, so a
+// registered colour says which sensor pixel was sampled. Two differences are expected:
+// - The window's mapping is the whole one's moved by a whole number of pixels, computed
+//   again in float32, so a point within a float's rounding of a tie between two pixels
+//   may round the other way: the two may differ by one pixel, at the few ties the scene
+//   has.
+// - The z-buffer's cells tile the window from its corner, so they lie otherwise than on
+//   the whole image: on the box's silhouette, within a cell (3 px here) of an occluded
+//   pixel, a point may compare with another nearest point and turn occluded or visible.
+TEST(ProjectiveRegistration, AColourWindowGivesTheWholeImagesColoursWhereItReaches) {
+  json document = testing::paper_rig_document();
+  document["depth_to_color"]["R"] = rotation(3, -4, 2);
+  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  const CalibrationFile file(document);
+  cv::Mat hidden_mm;
+  const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);
+  const cv::Mat sensor = coordinate_image();
+  const auto stage = make_registration(file.path());
+  const auto whole = register_color(*stage, depth, sensor);
+  const cv::Rect window(300, 250, 600, 480);
+  const auto part = register_color(*stage, depth, sensor(window).clone(), PixelFormat::kBgr8,
+                                   nullptr, window.tl());
+
+  cv::Mat near_occlusion;
+  cv::dilate(whole->status == RegisteredColor::kOccluded, near_occlusion,
+             cv::Mat::ones(7, 7, CV_8U));
+  const int occluded = cv::countNonZero(whole->status == RegisteredColor::kOccluded);
+  int inside = 0;
+  int outside = 0;
+  int moved = 0;
+  int turned = 0;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const auto status = whole->status.at<std::uint8_t>(v, u);
+      const auto part_status = part->status.at<std::uint8_t>(v, u);
+      const bool occlusion_turned =
+          (status == RegisteredColor::kOccluded && part_status == RegisteredColor::kValid) ||
+          (status == RegisteredColor::kValid && part_status == RegisteredColor::kOccluded);
+      if (occlusion_turned) {
+        EXPECT_NE(near_occlusion.at<std::uint8_t>(v, u), 0) << "(" << u << ", " << v << ")";
+        ++turned;
+        continue;
+      }
+      if (status != RegisteredColor::kValid) {
+        EXPECT_TRUE(part_status == status || part_status == RegisteredColor::kOutsideColor)
+            << "(" << u << ", " << v << ")";
+        continue;
+      }
+      const cv::Point sampled = decode(whole->bgr.at<cv::Vec3b>(v, u));
+      if (part_status != RegisteredColor::kValid) {
+        EXPECT_EQ(part_status, RegisteredColor::kOutsideColor) << "(" << u << ", " << v << ")";
+        EXPECT_FALSE(cv::Rect(window.x + 1, window.y + 1, window.width - 2, window.height - 2)
+                         .contains(sampled))
+            << "(" << u << ", " << v << ")";
+        ++outside;
+        continue;
+      }
+      const cv::Point part_sampled = decode(part->bgr.at<cv::Vec3b>(v, u));
+      EXPECT_TRUE(window.contains(part_sampled));
+      EXPECT_LE(cv::norm(part_sampled - sampled), std::sqrt(2.0)) << "(" << u << ", " << v << ")";
+      moved += part_sampled != sampled;
+      ++inside;
+    }
+  }
+  // The window shows about a quarter of what the depth pixels see (71 463 of 271 506).
+  EXPECT_GT(inside, 60000);
+  EXPECT_GT(outside, 180000);
+  EXPECT_LT(moved, inside / 1000);
+  EXPECT_GT(occluded, 500);           // the scene holds the case
+  EXPECT_LT(turned, occluded / 100);  // 6 of 3 598
+
+  EXPECT_EQ(process_error(*stage, depth, sensor(cv::Rect(0, 0, 640, 480)), PixelFormat::kBgr8,
+                          cv::Point(700, 100)),
+            "colour image window 640x480 px at (700, 100) is not inside the colour camera's "
+            "1280x1024 px image in the calibration " +
+                file.path().string());
+}
+
 // The 2x2 tile of each mosaic, row by row.
 std::string_view tile(PixelFormat format) {
   switch (format) {
@@ -838,16 +932,6 @@ TEST(ProjectiveRegistration, PapersLinearisationFailsForARotatedRig) {
             << static_cast<double>(e.max_px)
             << " px (with z + z_offset: " << static_cast<double>(e.max_with_optical_centre_depth_px)
             << " px)\n";
-}
-
-std::string process_error(Transform& stage, const cv::Mat& depth, const cv::Mat& color,
-                          PixelFormat format) {
-  try {
-    register_color(stage, depth, color, format);
-  } catch (const Error& error) {
-    return error.what();
-  }
-  return "registered";
 }
 
 TEST(ProjectiveRegistration, InputsThatDoNotFitTheCalibrationAreRefused) {

@@ -77,6 +77,41 @@ TEST(Calibration, RoundTripIsLossless) {
   EXPECT_DOUBLE_EQ(again.depth_to_color_r(0, 2), s);
 }
 
+// A window of the colour camera's sensor is that camera with its principal point moved
+// by the window's corner: a point projects to the same sensor pixel, less the corner.
+TEST(Calibration, AColourWindowMovesThePrincipalPointAndKeepsTheRest) {
+  const RigCalibration rig = parse_calibration(paper_rig_json(), "rig.json");
+  const RigCalibration windowed = with_color_window(rig, cv::Rect(288, 248, 704, 528));
+  EXPECT_EQ(windowed.color.width, 704);
+  EXPECT_EQ(windowed.color.height, 528);
+  EXPECT_DOUBLE_EQ(windowed.color.cx, rig.color.cx - 288);
+  EXPECT_DOUBLE_EQ(windowed.color.cy, rig.color.cy - 248);
+  EXPECT_DOUBLE_EQ(windowed.color.fx, rig.color.fx);
+  EXPECT_EQ(windowed.origin, "rig.json, colour window 704x528 px at (288, 248)");
+  json expected = to_json(rig);
+  expected["color_camera"]["width"] = 704;
+  expected["color_camera"]["height"] = 528;
+  expected["color_camera"]["cx"] = rig.color.cx - 288;
+  expected["color_camera"]["cy"] = rig.color.cy - 248;
+  EXPECT_EQ(to_json(windowed), expected);
+
+  EXPECT_EQ(to_json(with_color_window(rig, cv::Rect(0, 0, 1280, 1024))), to_json(rig));
+  for (const cv::Rect& outside : {cv::Rect(600, 0, 704, 528), cv::Rect(-1, 0, 100, 100),
+                                  cv::Rect(0, 1000, 100, 25), cv::Rect(10, 10, 0, 10)}) {
+    try {
+      with_color_window(rig, outside);
+      ADD_FAILURE() << outside.x << ", " << outside.y << " was taken as a window";
+    } catch (const Error& error) {
+      EXPECT_EQ(std::string(error.what()),
+                "colour image window " + std::to_string(outside.width) + "x" +
+                    std::to_string(outside.height) + " px at (" + std::to_string(outside.x) + ", " +
+                    std::to_string(outside.y) +
+                    ") is not inside the colour camera's 1280x1024 px image in the calibration "
+                    "rig.json");
+    }
+  }
+}
+
 TEST(Calibration, ErrorsNameTheField) {
   json missing = paper_rig_json();
   missing["depth_camera"].erase("fx");

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core/matx.hpp>
+#include <opencv2/core/types.hpp>
 
 namespace tilth {
 
@@ -54,6 +55,12 @@ RigCalibration parse_calibration(const nlohmann::json& document, const std::stri
 RigCalibration load_calibration(const std::filesystem::path& file);
 nlohmann::json to_json(const RigCalibration& calibration);
 void save_calibration(const RigCalibration& calibration, const std::filesystem::path& file);
+
+// The rig as it is when its colour camera reads out `window` of its sensor (a region of
+// interest: GenICam OffsetX, OffsetY, Width, Height): the colour camera's principal point
+// moved by the window's corner, its size the window's. Throws tilth::Error when the window
+// is not inside the calibrated colour image.
+RigCalibration with_color_window(const RigCalibration& rig, const cv::Rect& window);
 
 std::string_view to_string(DepthMeasure measure);
 

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
 
 #include "tilth/message.h"
 
@@ -24,6 +25,11 @@ struct ColorImage : MessageOf<ColorImage> {
   cv::Mat pixels;  // CV_8UC3 for bgr8/rgb8, CV_8UC1 for mono8 and Bayer
   PixelFormat format = PixelFormat::kBgr8;
   std::int64_t device_timestamp_ns = 0;  // capture time on this camera's clock
+  // Set by a camera that says where the image lies on its sensor: the sensor pixel of the
+  // image's top-left one. With a region of interest (GenICam OffsetX, OffsetY, Width,
+  // Height) the image is that window of the calibrated image (with_color_window). Unset:
+  // the image is the calibrated image whole.
+  std::optional<cv::Point> sensor_offset;
 
   std::string summary() const override;
 };
