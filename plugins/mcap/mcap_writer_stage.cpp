@@ -18,6 +18,9 @@
 // the chunks written before it, without a summary (`tilth recording repair` adds one),
 // and every frame not stored is reported as lost data.
 //
+// Colour images that are a window of the sensor (a camera's region of interest) are
+// recorded with the calibration of that window (RecordedColorWindow).
+//
 // As in a ROS 2 bag, a message's log (and publish) time is when the frame was captured
 // on the host's clock, so Foxglove shows wall-clock dates; each image's own timestamp
 // is its device time.
@@ -27,6 +30,7 @@
 #include <limits>
 #include <optional>
 
+#include "color_window/recorded_color_window.h"
 #include "mcap/ground_truth_message.h"
 #include "mcap/mcap_writer.h"
 #include "mcap/measurement_messages.h"
@@ -124,15 +128,12 @@ class McapWriterStage final : public Sink {
             parse_json(calibration_text_, context.params.path("calibration").string()),
             context.params.path("calibration").string())),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
-        color_size_(calibration_.color.width, calibration_.color.height),
+        color_window_(calibration_),
         writer_(context.params.path("path"), writer_options(context.params)),
         log_host_time_(context.params.string("log_time") == "host"),
         log_(context.log),
         report_data_loss_(context.report_data_loss) {
     const std::uint64_t created = now_ns();
-    writer_.add_attachment({created, created, std::string(kCalibrationAttachment),
-                            "application/json", calibration_text_});
-    writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", calibration_text_}}});
     const fs::path graph = context.params.string("graph_file");
     std::map<std::string, std::string> recording{{"node", context.node},
                                                  {"log_time", context.params.string("log_time")},
@@ -183,7 +184,12 @@ class McapWriterStage final : public Sink {
     }
     const auto sequence = static_cast<std::uint32_t>(frame_id);
     check_image("raw", raw.gray, CV_16UC1, depth_size_);
-    check_image("color", color.pixels, CV_8UC(channels(color.format)), color_size_);
+    if (rig_written_) {
+      color_window_.check(color);
+    } else {
+      color_window_.begin(color);
+    }
+    check_image("color", color.pixels, CV_8UC(channels(color.format)), color_window_.size());
     const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
     if (has_mask) check_image("truth mask", truth->residue_mask, CV_8UC1, depth_size_);
     if (measured.mask != nullptr) check_image("mask", measured.mask->values, CV_8UC1, depth_size_);
@@ -214,6 +220,7 @@ class McapWriterStage final : public Sink {
   void finish() override {
     if (failure_.empty()) {
       try {
+        if (!rig_written_) write_calibration_file();  // an empty recording still has its rig
         writer_.finish();
       } catch (const Error& error) {
         stop_recording(error.what());
@@ -255,12 +262,14 @@ class McapWriterStage final : public Sink {
       ++messages;
     };
     if (!rig_written_) {
+      write_calibration_file();
+      const RigCalibration& rig = color_window_.calibration();
       put(tof_calibration_channel_, raw_log_time,
-          encode_camera_calibration(calibration_.depth, kTofFrameId, time));
+          encode_camera_calibration(rig.depth, kTofFrameId, time));
       put(color_calibration_channel_, raw_log_time,
-          encode_camera_calibration(calibration_.color, kColorFrameId, time));
+          encode_camera_calibration(rig.color, kColorFrameId, time));
       put(transform_channel_, raw_log_time,
-          encode_color_pose(calibration_, kTofFrameId, kColorFrameId, time));
+          encode_color_pose(rig, kTofFrameId, kColorFrameId, time));
       rig_written_ = true;
     }
     put(raw_channel_, raw_log_time, encode_raw_image(raw.gray, "mono16", time, kTofFrameId));
@@ -294,6 +303,19 @@ class McapWriterStage final : public Sink {
     count_stored_frames();
   }
 
+  // The calibration as mcap.player reads it: the file given, or the one of the colour
+  // window the frames are (RecordedColorWindow). Written with the first frame, which
+  // says which.
+  void write_calibration_file() {
+    const std::string text = color_window_.whole()
+                                 ? calibration_text_
+                                 : to_json(color_window_.calibration()).dump(2) + "\n";
+    const std::uint64_t now = now_ns();
+    writer_.add_attachment(
+        {now, now, std::string(kCalibrationAttachment), "application/json", text});
+    writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", text}}});
+  }
+
   // Frames whose every message is in a chunk the file holds.
   void count_stored_frames() {
     while (!frame_ends_.empty() && frame_ends_.front() <= writer_.messages_written()) {
@@ -323,7 +345,7 @@ class McapWriterStage final : public Sink {
   const std::string calibration_text_;
   const RigCalibration calibration_;
   const cv::Size depth_size_;
-  const cv::Size color_size_;
+  RecordedColorWindow color_window_;
   McapWriter writer_;
   const bool log_host_time_;
   const Logger log_;

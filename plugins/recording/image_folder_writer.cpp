@@ -3,7 +3,9 @@
 // host_timestamps.csv. Every frame is checked against what the reader accepts before any
 // of its files is written, and its lines are appended and flushed only after its PNGs
 // are complete, host_timestamps.csv's before frames.csv's: a killed process leaves a
-// valid recording that lacks at most the frame being written.
+// valid recording that lacks at most the frame being written. Colour images that are a
+// window of the sensor (a camera's region of interest) are recorded with the calibration
+// of that window.
 #include <array>
 #include <fstream>
 #include <optional>
@@ -11,10 +13,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "color_window/recorded_color_window.h"
 #include "image_folder/frames_csv.h"
 #include "image_folder/host_timestamps_csv.h"
 #include "image_folder/pixel_checks.h"
 #include "image_folder/recording_json.h"
+#include "tilth/calibration.h"
 #include "tilth/json_input.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_truth.h"
@@ -93,7 +97,7 @@ class ImageFolderWriter final : public Sink {
         calibration_text_(read_json_text(context.params.path("calibration"), "calibration file")),
         description_(context.params.string("description")),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
-        color_size_(calibration_.color.width, calibration_.color.height) {
+        color_window_(calibration_) {
     check_folder(folder_, context.params.boolean("overwrite"));
   }
 
@@ -117,6 +121,11 @@ class ImageFolderWriter final : public Sink {
     check_order(entry);
     check("raw",
           pixel_mismatch(raw.gray, CV_16UC1, depth_size_, "depth_camera in the calibration"));
+    if (color_format_) {
+      color_window_.check(color);
+    } else {
+      color_window_.begin(color);
+    }
     const StoredColor stored = stored_color(color);
     if (!entry.mask.empty()) {
       check("truth mask", pixel_mismatch(truth->residue_mask, CV_8UC1, depth_size_,
@@ -152,7 +161,8 @@ class ImageFolderWriter final : public Sink {
     fs::create_directories(folder_ / "color");
     write_recording_json(folder_, std::string(kCalibrationFile), color_format, description_);
     std::ofstream calibration(folder_ / kCalibrationFile, std::ios::binary);
-    calibration << calibration_text_;
+    calibration << (color_window_.whole() ? calibration_text_
+                                          : to_json(color_window_.calibration()).dump(2) + "\n");
     if (!calibration) throw Error((folder_ / kCalibrationFile).string() + ": cannot write");
     host_csv_.open(folder_ / kHostTimestampsFile);
     append_line(host_csv_, std::string(kHostTimestampsHeader), folder_ / kHostTimestampsFile);
@@ -193,7 +203,7 @@ class ImageFolderWriter final : public Sink {
                   " as in the first frame (a recording has one color_format), got " +
                   std::string(to_string(color.format)));
     }
-    check("color", pixel_mismatch(color.pixels, CV_8UC(channels(format)), color_size_,
+    check("color", pixel_mismatch(color.pixels, CV_8UC(channels(format)), color_window_.size(),
                                   "color_camera in the calibration"));
     if (color.format != PixelFormat::kRgb8) return {format, color.pixels};
     cv::Mat bgr;
@@ -206,7 +216,7 @@ class ImageFolderWriter final : public Sink {
   const std::string calibration_text_;
   const std::string description_;
   const cv::Size depth_size_;
-  const cv::Size color_size_;
+  RecordedColorWindow color_window_;
   std::ofstream csv_;                        // frames.csv
   std::ofstream host_csv_;                   // host_timestamps.csv
   std::optional<PixelFormat> color_format_;  // set by start(), from the first written frame
@@ -221,13 +231,16 @@ StageDescriptor describe() {
       "host_timestamps.csv)";
   d.inputs = {
       PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
-      PortSpec::of<ColorImage>("color", "bgr8, rgb8 (stored as bgr8) or a Bayer mosaic"),
+      PortSpec::of<ColorImage>("color",
+                               "bgr8, rgb8 (stored as bgr8) or a Bayer mosaic; the calibration's "
+                               "size, or one window of the sensor"),
       PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
   };
   d.params = {
       ParamSpec::path("path", std::nullopt).describe("the recording folder to create"),
       ParamSpec::path("calibration", std::nullopt)
-          .describe("the rig's calibration file; copied into the folder as rig.calib.json"),
+          .describe("the rig's calibration file; copied into the folder as rig.calib.json, "
+                    "or that of the colour camera's window when the images are one"),
       ParamSpec::boolean("overwrite", false)
           .describe("replace the recording in an existing, non-empty folder"),
       ParamSpec::string("description", "").describe("free text for recording.json"),

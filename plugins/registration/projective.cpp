@@ -303,11 +303,10 @@ class ProjectiveRegistration final : public Transform {
   std::shared_ptr<const Geometry> geometry_for(std::shared_ptr<const Used> used,
                                                const ColorImage& color) {
     const RigCalibration& rig = *used->rig;
-    const cv::Rect whole(0, 0, rig.color.width, rig.color.height);
-    if (!color.sensor_offset || cv::Rect(*color.sensor_offset, color.pixels.size()) == whole) {
+    const cv::Rect window = color.sensor_window();
+    if (!color.sensor_offset || window == cv::Rect(0, 0, rig.color.width, rig.color.height)) {
       return {used, &used->derived};
     }
-    const cv::Rect window(*color.sensor_offset, color.pixels.size());
     std::lock_guard lock(window_mutex_);
     if (window_.rig != used->rig || window_.window != window) {
       auto geometry = std::make_shared<const Geometry>(with_color_window(rig, window), kernels_);

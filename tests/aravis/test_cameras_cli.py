@@ -251,6 +251,15 @@ class FakeCamerasGraph(unittest.TestCase):
         # One depth frame every 33.3 ms on the host clock, paired or not.
         self.assertAlmostEqual(statistics.median(gaps_ms), 33.3, delta=3.0)
         self.assertIn("pairs; unmatched and dropped:", stderr)
+        # The colour camera's window of its sensor, registered with that window's
+        # calibration: no frame refused for its size.
+        self.assertIn("chain/register: colour images are a window of the sensor: registering "
+                      "with ", stderr)
+        self.assertIn("paper_rig.calib.json, colour window 688x512 px at (400, 256)", stderr)
+        register = [line.split() for line in stderr.splitlines()
+                    if line.startswith("chain/register ")]
+        self.assertEqual(len(register), 1, stderr)
+        self.assertEqual(register[0][-2], "0", stderr)  # errors
 
 if __name__ == "__main__":
     unittest.main()

@@ -25,6 +25,7 @@ RunResult McapTest::record(const fs::path& file, PixelFormat format, json writer
     feed.color.pixels = frame.color;
     feed.color.format = format;
     feed.color.device_timestamp_ns = frame.color_timestamp_ns;
+    feed.color.sensor_offset = color_sensor_offset_;
     GroundTruth truth;
     truth.distance_mm = frame.ground_truth_mm;
     truth.residue_mask = frame.mask;

@@ -3,6 +3,7 @@
 // mcap.player, and the frame checks.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,8 @@ class McapTest : public RecordingTest {
 
   const fs::path calibration_file_ = dir_.path() / "small.calib.json";
   std::vector<TestFrame> frames_;
+  // Where record() says each colour image lies on the sensor (frames_ then hold a window).
+  std::optional<cv::Point> color_sensor_offset_;
 };
 
 }  // namespace tilth::testing

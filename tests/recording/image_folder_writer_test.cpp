@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "recording_fixture.h"
+#include "tilth/calibration.h"
 
 namespace tilth::testing {
 namespace {
@@ -205,6 +206,55 @@ TEST_F(ImageFolderWriterTest, Mono8CannotBeRecorded) {
 
 // The first frame fixes color_format; a frame in another format is refused before any of
 // its files is written.
+// A camera reading out a window of its colour sensor: the recording holds the window's
+// pixels and the window's calibration, so that replay registers them as the live graph
+// did; a frame of another window is refused, and a window whose calibration the reader
+// would refuse (the principal point outside it) is named before its frame is written.
+TEST_F(ImageFolderWriterTest, AColourWindowIsRecordedWithItsCalibration) {
+  frames_ = make_frames(3, small_calibration(), 3);
+  const cv::Rect window(10, 6, 24, 20);  // wide enough for the 1-degree field of view
+  for (TestFrame& frame : frames_) {
+    feed_.push_back(feed_of(frame, PixelFormat::kBgr8));
+    feed_.back().color.pixels = frame.color(window).clone();
+    feed_.back().color.sensor_offset = window.tl();
+    frame.color = frame.color(window).clone();
+  }
+  const RunResult result = run(feed_graph(copy_, {{"calibration", calibration_file_.string()}}));
+  ASSERT_FALSE(result.failed) << result.failure;
+  json expected = to_json(parse_calibration(small_calibration(), "small"));
+  expected["color_camera"]["width"] = 24;
+  expected["color_camera"]["height"] = 20;
+  expected["color_camera"]["cx"] = 19.5 - 10;
+  expected["color_camera"]["cy"] = 14.5 - 6;
+  EXPECT_EQ(json::parse(read_text(copy_ / "rig.calib.json")), expected);
+  expect_recording_holds_frames(copy_, PixelFormat::kBgr8);
+
+  frames_ = make_frames(2, small_calibration(), 3);
+  feed_.clear();
+  for (const TestFrame& frame : frames_) feed_.push_back(feed_of(frame, PixelFormat::kBgr8));
+  feed_[0].color.pixels = frames_[0].color(window).clone();
+  feed_[0].color.sensor_offset = window.tl();
+  feed_[1].color.sensor_offset = cv::Point(0, 0);
+  const fs::path changed = dir_.path() / "changed";
+  EXPECT_EQ(run(feed_graph(changed, {{"calibration", calibration_file_.string()}})).failure,
+            writer_failure("4 (sequence 1): color: the sensor's 40x30 px at (0, 0); expected "
+                           "the sensor's 24x20 px at (10, 6) as in the first frame (a "
+                           "recording has one colour window)"));
+
+  feed_.resize(1);
+  feed_[0].color.pixels = frames_[0].color(cv::Rect(22, 0, 18, 30)).clone();
+  feed_[0].color.sensor_offset = cv::Point(22, 0);
+  const fs::path corner = dir_.path() / "corner";
+  EXPECT_EQ(
+      run(feed_graph(corner, {{"calibration", calibration_file_.string()}})).failure,
+      writer_failure("3 (sequence 0): color: the calibration of the sensor's 18x30 px at (22, 0) "
+                     "cannot be recorded: " +
+                     calibration_file_.string() +
+                     ", colour window 18x30 px at (22, 0):/color_camera/cx: expected a number in "
+                     "[-0.5, 17.5] px: inside the 18-px width, got -2.5"));
+  EXPECT_FALSE(fs::exists(corner / "color" / "000003.png"));
+}
+
 TEST_F(ImageFolderWriterTest, ColorFormatMustNotChange) {
   frames_ = make_frames(2, small_calibration(), 1);
   feed_.push_back(feed_of(frames_[0], PixelFormat::kBayerBggr8));

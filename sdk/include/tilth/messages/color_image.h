@@ -31,6 +31,9 @@ struct ColorImage : MessageOf<ColorImage> {
   // the image is the calibrated image whole.
   std::optional<cv::Point> sensor_offset;
 
+  // The sensor pixels the image holds: at sensor_offset, or at (0, 0) when unset.
+  cv::Rect sensor_window() const { return {sensor_offset.value_or(cv::Point()), pixels.size()}; }
+
   std::string summary() const override;
 };
 
