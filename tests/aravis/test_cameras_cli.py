@@ -255,7 +255,7 @@ class FakeCamerasGraph(unittest.TestCase):
         # calibration: no frame refused for its size.
         self.assertIn("chain/register: colour images are a window of the sensor: registering "
                       "with ", stderr)
-        self.assertIn("paper_rig.calib.json, colour window 688x512 px at (400, 256)", stderr)
+        self.assertIn("paper_rig.calib.json, colour window 736x512 px at (368, 256)", stderr)
         register = [line.split() for line in stderr.splitlines()
                     if line.startswith("chain/register ")]
         self.assertEqual(len(register), 1, stderr)

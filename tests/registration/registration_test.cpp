@@ -25,6 +25,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calibration_file.h"
+#include "color_window/region_window.h"
 #include "depth_to_color.h"
 #include "projective.h"
 #include "reference_geometry.h"
@@ -642,6 +643,36 @@ TEST(ProjectiveRegistration, AColourWindowGivesTheWholeImagesColoursWhereItReach
             "colour image window 640x480 px at (700, 100) is not inside the colour camera's "
             "1280x1024 px image in the calibration " +
                 file.path().string());
+}
+
+// The window color_window_for gives for the chain's region and a range of ground
+// distances holds every colour pixel the registration of that region reads: a plane
+// anywhere in the range registers in the region exactly as with the whole image.
+TEST(ProjectiveRegistration, TheWindowARegionNeedsRegistersItAsTheWholeImage) {
+  const json document = testing::paper_rig_document();
+  const CalibrationFile file(document);
+  const ref::Rig rig = ref::rig_from(document);
+  const auto rays = depth_rays(rig);
+  const RegionOfInterest roi("middle_half", RegionOfInterest::Whole::kImage);
+  const cv::Rect region = roi.around(cv::Size(640, 480), RegionOfInterest::kMarginPx);
+  const cv::Rect window = color_window_for(load_calibration(file.path()), region, 400, 700, 16);
+  const cv::Mat sensor = coordinate_image();
+  const auto stage = make_registration(file.path(), "nearest", 10.0, "auto", "middle_half");
+  for (const Real distance_mm : {400.0L, 550.0L, 700.0L}) {
+    SCOPED_TRACE(std::to_string(static_cast<double>(distance_mm)) + " mm");
+    const cv::Mat depth = plane_depth(rig, rays, distance_mm, {0, 0, 1});
+    const auto whole = register_color(*stage, depth, sensor);
+    const auto part = register_color(*stage, depth, sensor(window).clone(), PixelFormat::kBgr8,
+                                     nullptr, window.tl());
+    EXPECT_EQ(cv::countNonZero(whole->status(region) != RegisteredColor::kValid), 0);
+    EXPECT_EQ(cv::countNonZero(part->status(region) != RegisteredColor::kValid), 0);
+    EXPECT_EQ(cv::norm(whole->bgr(region), part->bgr(region), cv::NORM_INF), 0.0);
+  }
+  // Beyond the range the region's far side leaves the window.
+  const auto too_near =
+      register_color(*stage, plane_depth(rig, rays, 300, {0, 0, 1}), sensor(window).clone(),
+                     PixelFormat::kBgr8, nullptr, window.tl());
+  EXPECT_GT(cv::countNonZero(too_near->status(region) == RegisteredColor::kOutsideColor), 0);
 }
 
 // The 2x2 tile of each mosaic, row by row.

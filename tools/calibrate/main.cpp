@@ -1,6 +1,7 @@
 // `tilth calibrate` (the tilth-calibrate program): a rig calibration file
 // (tilth-calibration/1) solved from checkerboard views of both cameras, or imported from
-// Basler's blaze + ace calibration result, and checked in the field on a recording.
+// Basler's blaze + ace calibration result, and checked in the field on a recording; the
+// colour camera window a rig's measured region needs.
 // docs/calibration.md is the user's guide.
 #include <charconv>
 #include <cmath>
@@ -22,11 +23,13 @@
 #include "board_views.h"
 #include "calibration_check.h"
 #include "check_report.h"
+#include "color_window/region_window.h"
 #include "command_line.h"
 #include "commands.h"
 #include "framework/nearest_names.h"
 #include "rig_facts.h"
 #include "rig_solver.h"
+#include "roi/region_of_interest.h"
 #include "solve_report.h"
 #include "stop_signals.h"
 #include "tilth/error.h"
@@ -105,6 +108,18 @@ constexpr const char* kUsage = R"(usage: tilth calibrate COMMAND ARGS
                         tof.exposure_us=800) and pair (pairing.depth_color); from a
                         recording, recording (recording.image_folder)
 
+  color-window RIG.calib.json --distance-mm NEAR:FAR
+      The window of the colour camera's image that registration reads for the
+      measured region when the ground is NEAR to FAR mm from the mounting surface,
+      as the GenICam features that make the camera read out only that (fewer bytes
+      per frame: pairs complete sooner). Put them in the colour camera's
+      "features"; frames then say where on the sensor they lie, and registration
+      and recordings use the window's calibration (docs/cameras.md).
+        --roi R         the chain's roi: middle_half (default), image, or
+                        {"x": X, "y": Y, "width": W, "height": H} in depth pixels
+        --step N        corner and size in multiples of N px (default 16; the
+                        camera's Width, Height, OffsetX and OffsetY increments)
+
 What neither the views nor Basler's file say (solve and import):
   --base RIG.calib.json   a calibration of the same rig whose other fields are kept
   --gray-to-mm G          the ToF camera's Scan3dCoordinateScale (mm per gray value)
@@ -145,13 +160,15 @@ const std::set<std::string> kSolveOptions =
 const std::set<std::string> kImportOptions = with_rig_facts({"--out"});
 const std::set<std::string> kCheckOptions = {"--calibration", "--frames", "--max-offset-px",
                                              "--overlay", "--report"};
+const std::set<std::string> kColorWindowOptions = {"--distance-mm", "--roi", "--step"};
 const std::set<std::string> kCaptureOptions = {"--recording", "--tof",      "--color",
                                                "--board",     "--out",      "--views",
                                                "--frames",    "--still-px", "--set"};
 
 std::set<std::string> all_valued() {
   std::set<std::string> all;
-  for (const auto* options : {&kSolveOptions, &kImportOptions, &kCheckOptions, &kCaptureOptions}) {
+  for (const auto* options :
+       {&kSolveOptions, &kImportOptions, &kCheckOptions, &kCaptureOptions, &kColorWindowOptions}) {
     all.insert(options->begin(), options->end());
   }
   return all;
@@ -485,6 +502,64 @@ int capture(const CommandLine& line) {
   return kExitOk;
 }
 
+// NEAR:FAR in mm.
+std::pair<double, double> parse_distances(const std::string& text) {
+  const auto colon = text.find(':');
+  double near_mm = 0;
+  double far_mm = 0;
+  const char* end = text.data() + text.size();
+  const bool parsed =
+      colon != std::string::npos &&
+      std::from_chars(text.data(), text.data() + colon, near_mm).ptr == text.data() + colon &&
+      std::from_chars(text.data() + colon + 1, end, far_mm).ptr == end;
+  if (!parsed || !(near_mm > 0) || !(far_mm >= near_mm)) {
+    throw Error(
+        "--distance-mm: expected NEAR:FAR in mm with 0 < NEAR <= FAR (e.g. 400:700), got '" + text +
+        "'");
+  }
+  return {near_mm, far_mm};
+}
+
+int color_window(const CommandLine& line) {
+  if (line.positional().size() != 2) {
+    return usage_error("color-window takes RIG.calib.json and --distance-mm NEAR:FAR");
+  }
+  if (const auto option = foreign_option(line, kColorWindowOptions)) {
+    return usage_error(*option + " is not a color-window option");
+  }
+  const auto distances = line.value("--distance-mm");
+  if (!distances) return usage_error("color-window needs --distance-mm NEAR:FAR");
+  std::pair<double, double> range;
+  int step = 16;
+  nlohmann::json roi_value = "middle_half";
+  try {
+    range = parse_distances(*distances);
+    step = static_cast<int>(line.count("--step", 1, 1024).value_or(16));
+    if (const auto roi = line.value("--roi")) {
+      roi_value = nlohmann::json::accept(*roi) ? nlohmann::json::parse(*roi) : nlohmann::json(*roi);
+    }
+  } catch (const Error& error) {
+    return usage_error(error.what());
+  }
+  const RigCalibration rig = tilth::load_calibration(line.positional()[1]);
+  const tilth::RegionOfInterest roi(roi_value, tilth::RegionOfInterest::Whole::kImage);
+  const cv::Size depth_size(rig.depth.width, rig.depth.height);
+  const cv::Rect region = roi.around(depth_size, tilth::RegionOfInterest::kMarginPx);
+  const cv::Rect window = tilth::color_window_for(rig, region, range.first, range.second, step);
+  const double share = 100.0 * window.area() / (rig.color.width * rig.color.height);
+  std::cout << "region " << roi_value.dump() << ": depth x " << region.x << ".."
+            << region.x + region.width - 1 << ", y " << region.y << ".."
+            << region.y + region.height - 1 << " with the " << tilth::RegionOfInterest::kMarginPx
+            << " px the segmentation reads\n"
+            << "colour window for ground " << range.first << " to " << range.second
+            << " mm away: " << window.width << "x" << window.height << " px at (" << window.x
+            << ", " << window.y << "), " << std::lround(share) << " % of the " << rig.color.width
+            << "x" << rig.color.height << " px image\n"
+            << "\"features\": [{\"Width\": " << window.width << "}, {\"Height\": " << window.height
+            << "}, {\"OffsetX\": " << window.x << "}, {\"OffsetY\": " << window.y << "}]\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -501,7 +576,7 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (line.positional().empty()) {
-    return usage_error("expected a command: solve, import, check or capture");
+    return usage_error("expected a command: solve, import, check, capture or color-window");
   }
   const std::string& command = line.positional()[0];
   try {
@@ -509,8 +584,10 @@ int main(int argc, char** argv) {
     if (command == "import") return import(line);
     if (command == "check") return check(line);
     if (command == "capture") return capture(line);
-    return usage_error("unknown command '" + command + "'" +
-                       tilth::did_you_mean(command, {"solve", "import", "check", "capture"}));
+    if (command == "color-window") return color_window(line);
+    return usage_error(
+        "unknown command '" + command + "'" +
+        tilth::did_you_mean(command, {"solve", "import", "check", "capture", "color-window"}));
   } catch (const std::exception& error) {
     std::cerr << "tilth calibrate: " << error.what() << "\n";
     return kExitFailed;
