@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Capture to Modbus register: how old a measurement is when a real Modbus master first
 reads it, with the two cameras free-running and with both fired by software triggers on
-the host clock (trigger_mode host_clock, pairing triggered; docs/pairing.md).
+the host clock (trigger_mode host_clock, pairing triggered; docs/pairing.md), and, for
+comparison, free-running with the whole colour image and the cameras' own packet size
+(graphs/fake-cameras.json reads out the window the chain needs, in 8000-byte packets).
 
-    python3 bench/capture_latency.py [--seconds 20]   (as root: it adds loopback addresses
-                                                        for the cameras)
+    python3 bench/capture_latency.py [--seconds 20] [--rounds 1]   (as root: it adds
+                                                  loopback addresses for the cameras)
 
 What runs, for each mode in turn: two GigE Vision camera simulators at 30 frames/s
-(640x480 Mono16 depth, 1280x1024 BayerRG8 colour; tilth-fake-gige-camera, which looks for
+(640x480 Mono16 depth, a 736x512 window of 1280x1024 BayerRG8 colour, or all of it in
+whole_image; tilth-fake-gige-camera, which looks for
 a trigger every millisecond) feed graphs/fake-cameras.json, whose measurement chain is
 served by modbus.output on a loopback port. A pymodbus master reads the register block
 every millisecond; at the first reading of each new frame id it keeps `age_ms`, the time
@@ -33,6 +36,11 @@ from pymodbus_tcp import ModbusTcpClient  # noqa: E402
 
 POLL_S = 0.001  # a master polling as fast as it can would take a core from the graph
 MODES = {
+    # graphs/fake-cameras.json before the colour window: the whole colour image, and the
+    # packet size the cameras negotiate.
+    "whole_image": {"cameras/depth": {"params": {"packet_size": 0}},
+                    "cameras/color": {"params": {"packet_size": 0,
+                                                 "features": {"Width": 1280, "Height": 1024}}}},
     "free_running": {},
     "host_clock": {"cameras/depth": {"params": {"trigger_mode": "host_clock"}},
                    "cameras/color": {"params": {"trigger_mode": "host_clock"}},
@@ -100,6 +108,8 @@ def run_mode(args, mode, work):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="run the modes in turn this many times (the VM's speed drifts)")
     parser.add_argument("--tilth", default=os.path.join(SOURCE, "build", "bin", "tilth"))
     parser.add_argument("--fake-camera",
                         default=os.path.join(SOURCE, "build", "bin", "tilth-fake-gige-camera"))
@@ -107,8 +117,14 @@ def main():
     os.environ["TILTH_FAKE_CAMERA"] = args.fake_camera
     work = tempfile.mkdtemp(prefix="tilth-latency-bench-")
     try:
-        for mode in MODES:
-            ages, read_ms = run_mode(args, mode, work)
+        results = {mode: ([], []) for mode in MODES}
+        for _ in range(args.rounds):
+            for mode in MODES:
+                ages, read_ms = run_mode(args, mode, work)
+                results[mode][0].extend(ages)
+                results[mode][1].append(read_ms)
+        for mode, (ages, read_times) in results.items():
+            read_ms = statistics.mean(read_times)
             ages.sort()
             if not ages:
                 print("%-12s no frame reached the registers" % mode)
