@@ -515,7 +515,7 @@ class Loader {
 Setting parse_setting(const std::string& option, const std::string& text) {
   const auto equals = text.find('=');
   if (equals == std::string::npos || equals == 0) {
-    throw Error(option + " " + text + ": expected KEY=VALUE");
+    throw Error(option + ": expected KEY=VALUE, got '" + text + "'");
   }
   return {text.substr(0, equals), text.substr(equals + 1)};
 }

@@ -248,7 +248,14 @@ TEST(GraphLoader, IncludeCycleIsReported) {
 
 TEST(GraphLoader, ParseSettingNeedsEquals) {
   EXPECT_EQ(parse_setting("--set", "a.b=c=d").value, "c=d");
-  EXPECT_THROW(parse_setting("--set", "a.b"), Error);
+  for (const std::string text : {"a.b", "", "=c"}) {
+    try {
+      parse_setting("--set", text);
+      ADD_FAILURE() << "'" << text << "' was taken as a setting";
+    } catch (const Error& error) {
+      EXPECT_EQ(std::string(error.what()), "--set: expected KEY=VALUE, got '" + text + "'");
+    }
+  }
 }
 
 // These aborted the process: nlohmann throws out_of_range, not parse_error, for a number
