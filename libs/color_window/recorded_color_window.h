@@ -1,12 +1,11 @@
-// The part of the colour sensor a recording holds, and the calibration it stores for it:
-// the calibrated image whole, or the window the first frame's camera read out (a region
-// of interest, ColorImage::sensor_offset), which every later frame must then be. Replay
-// uses the stored calibration as any recording's own, so windowed frames register as
-// they did live.
+// The part of the colour sensor a recording's images hold: the whole calibrated image, or
+// the window the first recorded frame's camera read out (a region of interest,
+// ColorImage::sensor_offset), which every later frame must then be. A recording stores the
+// rig's calibration as it is and the window beside it, and replay gives its images their
+// sensor_offset again, so that they register as they did live.
 #pragma once
 
 #include <optional>
-#include <string>
 
 #include <opencv2/core/types.hpp>
 
@@ -17,27 +16,20 @@ namespace tilth {
 
 class RecordedColorWindow {
  public:
-  explicit RecordedColorWindow(RigCalibration calibration);
+  explicit RecordedColorWindow(const CameraIntrinsics& color);
 
-  // Takes the window of the recording's first frame, replacing that of a first frame the
-  // recorder then refused. Throws tilth::Error ("color: ...") when the window's
-  // calibration would not be read back (a principal point outside it, a field of view
-  // under a degree).
-  void begin(const ColorImage& color);
-  // Throws tilth::Error ("color: ...") unless `color` is the first frame's window.
-  void check(const ColorImage& color) const;
-
-  cv::Size size() const { return window_.size(); }
-  bool whole() const { return !windowed_; }
-  // The calibration the recording stores: the given one, or its window's.
-  const RigCalibration& calibration() const { return windowed_ ? *windowed_ : calibration_; }
+  // The sensor pixels `color` holds. Throws tilth::Error ("color: ...") when they are not
+  // inside the calibrated image, or not the window of the frames recorded before.
+  cv::Rect check(const ColorImage& color) const;
+  // The recording's window from its first recorded frame on.
+  void take(const cv::Rect& window) { taken_ = window; }
+  // What the recording stores beside the calibration: the window, unless the images are
+  // the whole calibrated image.
+  std::optional<cv::Rect> stored() const;
 
  private:
-  cv::Rect window_of(const ColorImage& color) const;
-
-  const RigCalibration calibration_;
-  cv::Rect window_;
-  std::optional<RigCalibration> windowed_;
+  const cv::Rect whole_;
+  std::optional<cv::Rect> taken_;
 };
 
 }  // namespace tilth

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -12,11 +13,18 @@
 namespace tilth {
 namespace {
 
-// Ground distances looked at, evenly spaced in 1 / distance, as the parallax is.
+// Ground distances looked at, evenly spaced in 1 / distance (the parallax goes with 1 /
+// (distance + z_offset_mm); the two ends, where the window's edges lie, are exact).
 constexpr int kDistances = 8;
 // Sampling reads around the point: the nearest pixel's 2x2 Bayer quad, or the four
 // pixels bilinear interpolation blends.
 constexpr int kSamplingMarginPx = 2;
+
+std::string mm_text(double mm) {
+  std::ostringstream text;
+  text << mm << " mm";
+  return text.str();
+}
 
 int round_down(int value, int step) { return value / step * step; }
 int round_up(int value, int step) { return (value + step - 1) / step * step; }
@@ -26,14 +34,15 @@ int round_up(int value, int step) { return (value + step - 1) / step * step; }
 cv::Rect color_window_for(const RigCalibration& rig, const cv::Rect& depth_region, double near_mm,
                           double far_mm, int step) {
   if (!(near_mm > 0 && far_mm >= near_mm)) {
-    throw Error("ground distances " + std::to_string(near_mm) + " to " + std::to_string(far_mm) +
-                " mm; expected 0 < near <= far");
+    throw Error("ground distances " + mm_text(near_mm) + " to " + mm_text(far_mm) +
+                "; expected 0 < near <= far");
   }
   if (step < 1) throw Error("window step " + std::to_string(step) + " px; expected >= 1");
   const cv::Rect depth_image(0, 0, rig.depth.width, rig.depth.height);
   if (depth_region.empty() || (depth_region & depth_image) != depth_region) {
-    throw Error("the depth region is not inside the " + std::to_string(rig.depth.width) + "x" +
-                std::to_string(rig.depth.height) + " px depth image");
+    throw Error("the depth region " + window_text(depth_region) + " is not inside the " +
+                std::to_string(rig.depth.width) + "x" + std::to_string(rig.depth.height) +
+                " px depth image");
   }
   std::vector<cv::Point2d> pixels;
   pixels.reserve(static_cast<std::size_t>(depth_region.area()));
@@ -70,8 +79,9 @@ cv::Rect color_window_for(const RigCalibration& rig, const cv::Rect& depth_regio
     }
   }
   if (left > right) {
-    throw Error("the depth region sees none of the colour image at " + std::to_string(near_mm) +
-                " to " + std::to_string(far_mm) + " mm (calibration " + rig.origin + ")");
+    throw Error("the depth region " + window_text(depth_region) +
+                " sees none of the colour image with the ground " + mm_text(near_mm) + " to " +
+                mm_text(far_mm) + " away (calibration " + rig.origin + ")");
   }
   const int x0 =
       round_down(std::max(0, static_cast<int>(std::floor(left)) - kSamplingMarginPx), step);

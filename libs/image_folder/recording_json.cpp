@@ -43,6 +43,29 @@ RigCalibration read_calibration(const json& value, const fs::path& folder, const
   return load_calibration(folder / value.get<std::string>());
 }
 
+// {"x", "y", "width", "height"}: whole numbers, a window inside the calibrated image.
+cv::Rect read_color_window(const json& value, const CameraIntrinsics& color, const fs::path& file) {
+  const std::string expected =
+      "{\"x\", \"y\", \"width\", \"height\"} in pixels, inside the calibration's " +
+      std::to_string(color.width) + "x" + std::to_string(color.height) + " px colour image";
+  if (!value.is_object() || value.size() != 4) fail(file, "/color_window", expected, value);
+  std::array<int, 4> numbers{};
+  const std::array<const char*, 4> names{"x", "y", "width", "height"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto it = value.find(names[i]);
+    if (it == value.end() || !it->is_number_integer() || it->get<std::int64_t>() < 0 ||
+        it->get<std::int64_t>() > 1'000'000) {
+      fail(file, "/color_window", expected, value);
+    }
+    numbers[i] = it->get<int>();
+  }
+  const cv::Rect window(numbers[0], numbers[1], numbers[2], numbers[3]);
+  if (window.empty() || (window & cv::Rect(0, 0, color.width, color.height)) != window) {
+    fail(file, "/color_window", expected, value);
+  }
+  return window;
+}
+
 }  // namespace
 
 bool is_recording_color_format(PixelFormat format) {
@@ -67,7 +90,7 @@ RecordingJson read_recording_json(const fs::path& folder) {
   if (!document.is_object()) fail(file, "", "an object", document);
   for (const auto& [key, value] : document.items()) {
     if (key != "format" && key != "calibration" && key != "color_format" && key != "description" &&
-        key != "tags") {
+        key != "tags" && key != "color_window") {
       throw Error(file.string() + ":/" + key + ": no such field (misspelt?)");
     }
   }
@@ -98,15 +121,25 @@ RecordingJson read_recording_json(const fs::path& folder) {
     }
   }
   recording.calibration = read_calibration(required(document, file, "calibration"), folder, file);
+  if (const auto it = document.find("color_window"); it != document.end()) {
+    recording.color_window = read_color_window(*it, recording.calibration.color, file);
+  }
   return recording;
 }
 
 void write_recording_json(const fs::path& folder, const std::string& calibration_file,
-                          PixelFormat color_format, const std::string& description) {
-  const json document = {{"format", std::string(kFormat)},
-                         {"calibration", calibration_file},
-                         {"color_format", std::string(to_string(color_format))},
-                         {"description", description}};
+                          PixelFormat color_format, const std::string& description,
+                          const std::optional<cv::Rect>& color_window) {
+  json document = {{"format", std::string(kFormat)},
+                   {"calibration", calibration_file},
+                   {"color_format", std::string(to_string(color_format))},
+                   {"description", description}};
+  if (color_window) {
+    document["color_window"] = {{"x", color_window->x},
+                                {"y", color_window->y},
+                                {"width", color_window->width},
+                                {"height", color_window->height}};
+  }
   const fs::path file = folder / "recording.json";
   const fs::path temporary = folder / "recording.json.tmp";
   {

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mcap/color_window_metadata.h"
 #include "mcap/ground_truth_message.h"
 #include "mcap/mcap_reader.h"
 #include "mcap/measurement_messages.h"
@@ -81,6 +82,7 @@ class McapPlayer final : public Source {
   explicit McapPlayer(const StageContext& context)
       : reader_(context.params.path("path")),
         calibration_(std::make_shared<const RigCalibration>(read_calibration(reader_))),
+        color_window_(read_color_window(reader_, calibration_->color)),
         clock_(context.params.number("rate")),
         host_time_(context.params),
         log_(context.log) {
@@ -221,8 +223,9 @@ class McapPlayer final : public Source {
     return reader_.file().string() + ": " + topic + " frame " + std::to_string(message.sequence);
   }
 
-  // The image of a message, in the calibration's size; `encoding` "" accepts any.
-  RawImage image(const Message& message, cv::Size size, std::string_view encoding) const {
+  // The image of a message, in `size` (`size_from` says whose); `encoding` "" accepts any.
+  RawImage image(const Message& message, cv::Size size, std::string_view encoding,
+                 std::string_view size_from = "the calibration's size") const {
     RawImage decoded = decode_raw_image(message.data, where(message));
     if (!encoding.empty() && decoded.encoding != encoding) {
       throw Error(where(message) + ": expected encoding " + std::string(encoding) + ", got " +
@@ -230,7 +233,7 @@ class McapPlayer final : public Source {
     }
     if (decoded.pixels.size() != size) {
       throw Error(where(message) + ": expected " + std::to_string(size.width) + "x" +
-                  std::to_string(size.height) + " (the calibration's size), got " +
+                  std::to_string(size.height) + " (" + std::string(size_from) + "), got " +
                   std::to_string(decoded.pixels.cols) + "x" + std::to_string(decoded.pixels.rows));
     }
     return decoded;
@@ -245,7 +248,9 @@ class McapPlayer final : public Source {
 
   Outputs decode(const RecordedFrame& recorded) const {
     const cv::Size depth_size(calibration_->depth.width, calibration_->depth.height);
-    const cv::Size color_size(calibration_->color.width, calibration_->color.height);
+    const cv::Size color_size =
+        color_window_ ? color_window_->size()
+                      : cv::Size(calibration_->color.width, calibration_->color.height);
     Outputs outputs;
 
     RawImage raw_image = image(*recorded.raw, depth_size, "mono16");
@@ -253,7 +258,9 @@ class McapPlayer final : public Source {
     outputs.raw.device_timestamp_ns = raw_image.timestamp_ns;
     outputs.raw.rig = calibration_;
 
-    RawImage color_image = image(*recorded.color, color_size, "");
+    RawImage color_image =
+        image(*recorded.color, color_size, "",
+              color_window_ ? "the recording's colour window" : "the calibration's size");
     const std::optional<PixelFormat> format = parse_pixel_format(color_image.encoding);
     if (!format) {
       throw Error(where(*recorded.color) + ": encoding " + color_image.encoding +
@@ -262,6 +269,7 @@ class McapPlayer final : public Source {
     outputs.color.format = *format;
     outputs.color.pixels = std::move(color_image.pixels);
     outputs.color.device_timestamp_ns = color_image.timestamp_ns;
+    if (color_window_) outputs.color.sensor_offset = color_window_->tl();
 
     if (recorded.truth) {
       outputs.truth.distance_mm =
@@ -287,6 +295,7 @@ class McapPlayer final : public Source {
 
   McapReader reader_;
   const std::shared_ptr<const RigCalibration> calibration_;  // the frames carry it
+  const std::optional<cv::Rect> color_window_;  // the colour images' window of the sensor
   PlaybackClock clock_;
   const ReplayHostTime host_time_;
   const Logger log_;

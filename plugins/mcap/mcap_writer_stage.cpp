@@ -19,7 +19,8 @@
 // and every frame not stored is reported as lost data.
 //
 // Colour images that are a window of the sensor (a camera's region of interest) are
-// recorded with the calibration of that window (RecordedColorWindow).
+// recorded with that window (metadata tilth.color_window, RecordedColorWindow), and
+// /color/calibration holds the window's intrinsics.
 //
 // As in a ROS 2 bag, a message's log (and publish) time is when the frame was captured
 // on the host's clock, so Foxglove shows wall-clock dates; each image's own timestamp
@@ -31,6 +32,7 @@
 #include <optional>
 
 #include "color_window/recorded_color_window.h"
+#include "mcap/color_window_metadata.h"
 #include "mcap/ground_truth_message.h"
 #include "mcap/mcap_writer.h"
 #include "mcap/measurement_messages.h"
@@ -128,12 +130,15 @@ class McapWriterStage final : public Sink {
             parse_json(calibration_text_, context.params.path("calibration").string()),
             context.params.path("calibration").string())),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
-        color_window_(calibration_),
+        color_window_(calibration_.color),
         writer_(context.params.path("path"), writer_options(context.params)),
         log_host_time_(context.params.string("log_time") == "host"),
         log_(context.log),
         report_data_loss_(context.report_data_loss) {
     const std::uint64_t created = now_ns();
+    writer_.add_attachment({created, created, std::string(kCalibrationAttachment),
+                            "application/json", calibration_text_});
+    writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", calibration_text_}}});
     const fs::path graph = context.params.string("graph_file");
     std::map<std::string, std::string> recording{{"node", context.node},
                                                  {"log_time", context.params.string("log_time")},
@@ -184,12 +189,8 @@ class McapWriterStage final : public Sink {
     }
     const auto sequence = static_cast<std::uint32_t>(frame_id);
     check_image("raw", raw.gray, CV_16UC1, depth_size_);
-    if (rig_written_) {
-      color_window_.check(color);
-    } else {
-      color_window_.begin(color);
-    }
-    check_image("color", color.pixels, CV_8UC(channels(color.format)), color_window_.size());
+    const cv::Rect window = color_window_.check(color);
+    check_image("color", color.pixels, CV_8UC(channels(color.format)), window.size());
     const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
     if (has_mask) check_image("truth mask", truth->residue_mask, CV_8UC1, depth_size_);
     if (measured.mask != nullptr) check_image("mask", measured.mask->values, CV_8UC1, depth_size_);
@@ -211,7 +212,7 @@ class McapWriterStage final : public Sink {
       return;
     }
     try {
-      write_frame(raw, color, truth, measured, sequence, raw_log_time, color_log_time);
+      write_frame(raw, color, window, truth, measured, sequence, raw_log_time, color_log_time);
     } catch (const Error& error) {
       stop_recording(error.what());
     }
@@ -220,7 +221,6 @@ class McapWriterStage final : public Sink {
   void finish() override {
     if (failure_.empty()) {
       try {
-        if (!rig_written_) write_calibration_file();  // an empty recording still has its rig
         writer_.finish();
       } catch (const Error& error) {
         stop_recording(error.what());
@@ -233,9 +233,9 @@ class McapWriterStage final : public Sink {
   }
 
  private:
-  void write_frame(const RawTofFrame& raw, const ColorImage& color, const GroundTruth* truth,
-                   const Measured& measured, std::uint32_t sequence, std::uint64_t raw_log_time,
-                   std::uint64_t color_log_time) {
+  void write_frame(const RawTofFrame& raw, const ColorImage& color, const cv::Rect& window,
+                   const GroundTruth* truth, const Measured& measured, std::uint32_t sequence,
+                   std::uint64_t raw_log_time, std::uint64_t color_log_time) {
     const bool has_mask = truth != nullptr && !truth->residue_mask.empty();
     const std::int64_t time = raw.device_timestamp_ns;
     // Channels of what the chain measured are added with the first frame that has it,
@@ -262,8 +262,13 @@ class McapWriterStage final : public Sink {
       ++messages;
     };
     if (!rig_written_) {
-      write_calibration_file();
-      const RigCalibration& rig = color_window_.calibration();
+      color_window_.take(window);
+      // The images' own intrinsics, as viewers expect of /color/calibration.
+      RigCalibration rig = calibration_;
+      if (const auto stored = color_window_.stored()) {
+        writer_.add_metadata(color_window_metadata(*stored));
+        rig = with_color_window(calibration_, *stored);
+      }
       put(tof_calibration_channel_, raw_log_time,
           encode_camera_calibration(rig.depth, kTofFrameId, time));
       put(color_calibration_channel_, raw_log_time,
@@ -301,19 +306,6 @@ class McapWriterStage final : public Sink {
     frame_ends_.push_back(messages_given_);
     writer_.close_chunk_if_full();
     count_stored_frames();
-  }
-
-  // The calibration as mcap.player reads it: the file given, or the one of the colour
-  // window the frames are (RecordedColorWindow). Written with the first frame, which
-  // says which.
-  void write_calibration_file() {
-    const std::string text = color_window_.whole()
-                                 ? calibration_text_
-                                 : to_json(color_window_.calibration()).dump(2) + "\n";
-    const std::uint64_t now = now_ns();
-    writer_.add_attachment(
-        {now, now, std::string(kCalibrationAttachment), "application/json", text});
-    writer_.add_metadata({std::string(kCalibrationMetadata), {{"json", text}}});
   }
 
   // Frames whose every message is in a chunk the file holds.

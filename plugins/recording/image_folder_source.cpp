@@ -36,6 +36,7 @@ namespace fs = std::filesystem;
 constexpr std::size_t kRawPort = 0;
 constexpr std::size_t kColorPort = 1;
 constexpr std::size_t kTruthPort = 2;
+constexpr std::string_view kDepthSize = "depth_camera in the calibration";
 
 // Each frame's host capture time from host_timestamps.csv; none without the file.
 std::vector<std::int64_t> recorded_host_timestamps(const fs::path& folder,
@@ -142,19 +143,23 @@ class ImageFolderSource final : public Source {
   DecodedFrame read_images(const FrameEntry& entry) const {
     const cv::Size depth_size(recording_.calibration.depth.width,
                               recording_.calibration.depth.height);
-    const cv::Size color_size(recording_.calibration.color.width,
-                              recording_.calibration.color.height);
+    const cv::Size color_size =
+        recording_.color_window
+            ? recording_.color_window->size()
+            : cv::Size(recording_.calibration.color.width, recording_.calibration.color.height);
     DecodedFrame decoded;
     FrameImages images;
     images.depth =
-        read_image(entry, entry.depth, CV_16UC1, depth_size, "depth_camera", decoded.skipped);
+        read_image(entry, entry.depth, CV_16UC1, depth_size, kDepthSize, decoded.skipped);
     if (images.depth.empty()) return decoded;
-    images.color = read_image(entry, entry.color, CV_8UC(channels(recording_.color_format)),
-                              color_size, "color_camera", decoded.skipped);
+    images.color =
+        read_image(entry, entry.color, CV_8UC(channels(recording_.color_format)), color_size,
+                   recording_.color_window ? "color_window in recording.json"
+                                           : "color_camera in the calibration",
+                   decoded.skipped);
     if (images.color.empty()) return decoded;
     if (!entry.mask.empty()) {
-      images.mask =
-          read_image(entry, entry.mask, CV_8UC1, depth_size, "depth_camera", decoded.skipped);
+      images.mask = read_image(entry, entry.mask, CV_8UC1, depth_size, kDepthSize, decoded.skipped);
       if (images.mask.empty()) return decoded;
     }
     decoded.images = std::move(images);
@@ -163,8 +168,9 @@ class ImageFolderSource final : public Source {
 
   // An empty image, and `skipped` saying why, when the file is missing or unreadable and
   // on_missing is skip.
+  // `size_from` says where `size` comes from, for the error.
   cv::Mat read_image(const FrameEntry& entry, const std::string& relative, int type, cv::Size size,
-                     std::string_view camera, std::string& skipped) const {
+                     std::string_view size_from, std::string& skipped) const {
     const fs::path file = folder_ / relative;
     const std::string where =
         file.string() + " (frames.csv line " + std::to_string(entry.line) + ")";
@@ -183,8 +189,7 @@ class ImageFolderSource final : public Source {
                 " skipped (on_missing: skip)";
       return {};
     }
-    const std::string mismatch =
-        pixel_mismatch(image, type, size, std::string(camera) + " in the calibration");
+    const std::string mismatch = pixel_mismatch(image, type, size, std::string(size_from));
     if (!mismatch.empty()) throw Error(where + ": " + mismatch);
     return image;
   }
@@ -206,6 +211,7 @@ class ImageFolderSource final : public Source {
     color.pixels = std::move(images.color);
     color.format = recording_.color_format;
     color.device_timestamp_ns = entry.color_timestamp_ns;
+    if (recording_.color_window) color.sensor_offset = recording_.color_window->tl();
     frame.emit(kColorPort, std::move(color));
     GroundTruth truth;
     truth.distance_mm = entry.ground_truth_mm;

@@ -4,8 +4,8 @@
 // of its files is written, and its lines are appended and flushed only after its PNGs
 // are complete, host_timestamps.csv's before frames.csv's: a killed process leaves a
 // valid recording that lacks at most the frame being written. Colour images that are a
-// window of the sensor (a camera's region of interest) are recorded with the calibration
-// of that window.
+// window of the sensor (a camera's region of interest) are recorded with that window in
+// recording.json (RecordedColorWindow).
 #include <array>
 #include <fstream>
 #include <optional>
@@ -97,7 +97,7 @@ class ImageFolderWriter final : public Sink {
         calibration_text_(read_json_text(context.params.path("calibration"), "calibration file")),
         description_(context.params.string("description")),
         depth_size_(calibration_.depth.width, calibration_.depth.height),
-        color_window_(calibration_) {
+        color_window_(calibration_.color) {
     check_folder(folder_, context.params.boolean("overwrite"));
   }
 
@@ -121,18 +121,14 @@ class ImageFolderWriter final : public Sink {
     check_order(entry);
     check("raw",
           pixel_mismatch(raw.gray, CV_16UC1, depth_size_, "depth_camera in the calibration"));
-    if (color_format_) {
-      color_window_.check(color);
-    } else {
-      color_window_.begin(color);
-    }
-    const StoredColor stored = stored_color(color);
+    const cv::Rect window = color_window_.check(color);
+    const StoredColor stored = stored_color(color, window.size());
     if (!entry.mask.empty()) {
       check("truth mask", pixel_mismatch(truth->residue_mask, CV_8UC1, depth_size_,
                                          "depth_camera in the calibration"));
     }
 
-    if (!color_format_) start(stored.format);
+    if (!color_format_) start(stored.format, window);
     write_png(folder_ / entry.depth, raw.gray);
     write_png(folder_ / entry.color, stored.pixels);
     if (!entry.mask.empty()) {
@@ -147,22 +143,24 @@ class ImageFolderWriter final : public Sink {
 
   void finish() override {
     // A recording without frames is still a valid, empty one.
-    if (!color_format_) start(PixelFormat::kBgr8);
+    if (!color_format_) start(PixelFormat::kBgr8, std::nullopt);
     close_file(csv_, folder_ / "frames.csv");
     close_file(host_csv_, folder_ / kHostTimestampsFile);
   }
 
  private:
-  // Replaces the old recording, if any, with an empty one in `color_format`. Runs with
-  // the first frame to write, so a graph that does not run changes nothing.
-  void start(PixelFormat color_format) {
+  // Replaces the old recording, if any, with an empty one in `color_format` whose colour
+  // images are `window` of the sensor (none: the whole image). Runs with the first frame
+  // to write, so a graph that does not run changes nothing.
+  void start(PixelFormat color_format, const std::optional<cv::Rect>& window) {
+    if (window) color_window_.take(*window);
     for (std::string_view entry : kRecordingEntries) fs::remove_all(folder_ / entry);
     fs::create_directories(folder_ / "depth");
     fs::create_directories(folder_ / "color");
-    write_recording_json(folder_, std::string(kCalibrationFile), color_format, description_);
+    write_recording_json(folder_, std::string(kCalibrationFile), color_format, description_,
+                         color_window_.stored());
     std::ofstream calibration(folder_ / kCalibrationFile, std::ios::binary);
-    calibration << (color_window_.whole() ? calibration_text_
-                                          : to_json(color_window_.calibration()).dump(2) + "\n");
+    calibration << calibration_text_;
     if (!calibration) throw Error((folder_ / kCalibrationFile).string() + ": cannot write");
     host_csv_.open(folder_ / kHostTimestampsFile);
     append_line(host_csv_, std::string(kHostTimestampsHeader), folder_ / kHostTimestampsFile);
@@ -191,7 +189,7 @@ class ImageFolderWriter final : public Sink {
 
   // The colour image as the recording stores it: rgb8 becomes bgr8, and the format must
   // be the one of the first frame.
-  StoredColor stored_color(const ColorImage& color) const {
+  StoredColor stored_color(const ColorImage& color, cv::Size window) const {
     const PixelFormat format =
         color.format == PixelFormat::kRgb8 ? PixelFormat::kBgr8 : color.format;
     if (!is_recording_color_format(format)) {
@@ -203,7 +201,8 @@ class ImageFolderWriter final : public Sink {
                   " as in the first frame (a recording has one color_format), got " +
                   std::string(to_string(color.format)));
     }
-    check("color", pixel_mismatch(color.pixels, CV_8UC(channels(format)), color_window_.size(),
+    // A window's size is its image's: only a whole image can mismatch.
+    check("color", pixel_mismatch(color.pixels, CV_8UC(channels(format)), window,
                                   "color_camera in the calibration"));
     if (color.format != PixelFormat::kRgb8) return {format, color.pixels};
     cv::Mat bgr;
@@ -233,14 +232,13 @@ StageDescriptor describe() {
       PortSpec::of<RawTofFrame>("raw", "16-bit ToF gray, the calibration's depth_camera size"),
       PortSpec::of<ColorImage>("color",
                                "bgr8, rgb8 (stored as bgr8) or a Bayer mosaic; the calibration's "
-                               "size, or one window of the sensor"),
+                               "size, or one window of the sensor (ColorImage::sensor_offset)"),
       PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
   };
   d.params = {
       ParamSpec::path("path", std::nullopt).describe("the recording folder to create"),
       ParamSpec::path("calibration", std::nullopt)
-          .describe("the rig's calibration file; copied into the folder as rig.calib.json, "
-                    "or that of the colour camera's window when the images are one"),
+          .describe("the rig's calibration file; copied into the folder as rig.calib.json"),
       ParamSpec::boolean("overwrite", false)
           .describe("replace the recording in an existing, non-empty folder"),
       ParamSpec::string("description", "").describe("free text for recording.json"),

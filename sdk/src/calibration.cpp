@@ -321,19 +321,20 @@ json to_json(const RigCalibration& rig) {
          {rig.depth_to_color_t_mm[0], rig.depth_to_color_t_mm[1], rig.depth_to_color_t_mm[2]}}}}};
 }
 
+std::string window_text(const cv::Rect& window) {
+  return std::to_string(window.width) + "x" + std::to_string(window.height) + " px at (" +
+         std::to_string(window.x) + ", " + std::to_string(window.y) + ")";
+}
+
 RigCalibration with_color_window(const RigCalibration& rig, const cv::Rect& window) {
   const cv::Rect sensor(0, 0, rig.color.width, rig.color.height);
-  const auto text = [](const cv::Rect& r) {
-    return std::to_string(r.width) + "x" + std::to_string(r.height) + " px at (" +
-           std::to_string(r.x) + ", " + std::to_string(r.y) + ")";
-  };
   if (window.empty() || (window & sensor) != window) {
-    throw Error("colour image window " + text(window) + " is not inside the colour camera's " +
-                std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
-                " px image in the calibration " + rig.origin);
+    throw Error("colour image window " + window_text(window) +
+                " is not inside the colour camera's " + std::to_string(sensor.width) + "x" +
+                std::to_string(sensor.height) + " px image in the calibration " + rig.origin);
   }
   RigCalibration windowed = rig;
-  windowed.origin = rig.origin + ", colour window " + text(window);
+  windowed.origin = rig.origin + ", colour window " + window_text(window);
   windowed.color.width = window.width;
   windowed.color.height = window.height;
   windowed.color.cx = rig.color.cx - window.x;

@@ -129,6 +129,26 @@ TEST_F(CalibrateCapture, KeepsTheThirdStillFrameOfEachPoseOnceAndStopsAtViews) {
       << stopped.output;
 }
 
+// Frames of a colour window (a camera's region of interest) are no views of the whole
+// image the calibration describes.
+TEST_F(CalibrateCapture, RefusesColourImagesThatAreAWindowOfTheSensor) {
+  const fs::path windowed = dir_.path() / "windowed";
+  std::vector<TestFrame> frames(held_.frames.begin(), held_.frames.begin() + 2);
+  for (TestFrame& frame : frames) frame.color = frame.color(cv::Rect(100, 64, 640, 480)).clone();
+  write_recording(windowed, frames, "bayer_rggb8", to_json(truth_));
+  nlohmann::json document = nlohmann::json::parse(read_text(windowed / "recording.json"));
+  document["color_window"] = {{"x", 100}, {"y", 64}, {"width", 640}, {"height", 480}};
+  write_text(windowed / "recording.json", document.dump());
+  const auto run = run_calibrate("capture --recording " + windowed.string() +
+                                 " --board 8x5 --out " + (dir_.path() / "views").string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("the colour images are a window of the sensor (640x480 px at (100, "
+                            "64)); calibrate with the whole image: OffsetX and OffsetY 0, Width "
+                            "and Height the sensor's"),
+            std::string::npos)
+      << run.output;
+}
+
 TEST_F(CalibrateCapture, TheKeptViewsSolveToTheRigsTruth) {
   const fs::path views = dir_.path() / "views";
   ASSERT_EQ(run_calibrate("capture --recording " + recording().string() + " --board 8x5 --out " +

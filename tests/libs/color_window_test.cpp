@@ -54,10 +54,21 @@ TEST(ColorWindow, ArgumentsThatMakeNoWindowAreRefused) {
     return std::string("a window");
   };
   EXPECT_EQ(error(kRegion, 700, 400, 16),
-            "ground distances 700.000000 to 400.000000 mm; expected 0 < near <= far");
+            "ground distances 700 mm to 400 mm; expected 0 < near <= far");
   EXPECT_EQ(error(kRegion, 400, 700, 0), "window step 0 px; expected >= 1");
   EXPECT_EQ(error(cv::Rect(600, 0, 100, 10), 400, 700, 16),
-            "the depth region is not inside the 640x480 px depth image");
+            "the depth region 100x10 px at (600, 0) is not inside the 640x480 px depth image");
+  RigCalibration apart = paper_rig();
+  apart.depth_to_color_t_mm = cv::Vec3d(5000, 0, 0);  // the colour camera 5 m to the side
+  try {
+    color_window_for(apart, kRegion, 400, 700, 16);
+    ADD_FAILURE() << "a window for a camera that sees none of the region";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "the depth region 336x256 px at (152, 112) sees none of the colour image with the "
+              "ground 400 mm to 700 mm away (calibration " +
+                  testing::paper_rig_path().string() + ")");
+  }
 }
 
 }  // namespace

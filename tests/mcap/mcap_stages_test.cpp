@@ -176,14 +176,14 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
 
   EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
   EXPECT_EQ(reader.find_attachment("recorded.graph.json")->data, read_text(graph_file));
-  ASSERT_EQ(reader.metadata().size(), 2u);  // the recording's, then with the first frame the rig's
-  EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values.at("json"),
+  ASSERT_EQ(reader.metadata().size(), 2u);
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("json"),
             read_text(calibration_file_));
   const std::map<std::string, std::string> recording{{"node", "w"},
                                                      {"graph_file", "recorded.graph.json"},
                                                      {"log_time", "host"},
                                                      {"tilth_version", std::string(version())}};
-  EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values, recording);
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values, recording);
 
   // The first colour message: a RawImage in CDR, byte by byte where it is not pixels.
   const std::vector<mcap::Message> messages = reader.read_chunk(reader.chunks().front());
@@ -227,51 +227,49 @@ TEST_F(McapStagesTest, FileHoldsChannelsSchemasCalibrationAndSummary) {
       << mcap::format_info(info);
 }
 
-// The window is in log time, the host capture times, here twice as far apart as the
-// device times.
-// A camera reading out a window of its colour sensor: the file holds the window's pixels
-// and, as its rig, the window's calibration, which mcap.player hands to the chain; a
-// window whose calibration the player would refuse (the principal point outside it) is
-// named.
-TEST_F(McapStagesTest, AColourWindowIsRecordedWithItsCalibration) {
-  frames_ = make_frames(3, small_calibration(), 3);
-  const cv::Rect window(10, 6, 24, 20);  // wide enough for the 1-degree field of view
-  for (TestFrame& frame : frames_) frame.color = frame.color(window).clone();
-  color_sensor_offset_ = window.tl();
-  const fs::path file = dir_.path() / "window.mcap";
-  const RunResult recorded = record(file, PixelFormat::kBgr8);
-  ASSERT_FALSE(recorded.failed) << recorded.failure;
+// A camera reading out a window of its colour sensor: the file holds the window's pixels,
+// the rig's calibration as given, the window (metadata tilth.color_window) and, on
+// /color/calibration, the window's intrinsics; mcap.player gives each image its place on
+// the sensor again. A window off the image's centre records as well.
+TEST_F(McapStagesTest, AColourWindowIsRecordedAndPlayedWhereItLies) {
+  for (const cv::Rect& window : {cv::Rect(10, 6, 24, 20), cv::Rect(30, 0, 10, 8)}) {
+    SCOPED_TRACE(window_text(window));
+    frames_ = make_frames(3, small_calibration(), 3);
+    for (TestFrame& frame : frames_) frame.color = frame.color(window).clone();
+    color_sensor_offset_ = window.tl();
+    const fs::path file = dir_.path() / "window.mcap";
+    fs::remove(file);
+    const RunResult recorded = record(file, PixelFormat::kBgr8);
+    ASSERT_FALSE(recorded.failed) << recorded.failure;
 
-  json expected = to_json(parse_calibration(small_calibration(), "small"));
-  expected["color_camera"]["width"] = 24;
-  expected["color_camera"]["height"] = 20;
-  expected["color_camera"]["cx"] = 19.5 - 10;
-  expected["color_camera"]["cy"] = 14.5 - 6;
-  mcap::McapReader reader(file);
-  EXPECT_EQ(json::parse(reader.find_attachment("rig.calib.json")->data), expected);
-  EXPECT_EQ(json::parse(reader.read_metadata(reader.metadata()[1]).values.at("json")), expected);
-  const json color_calibration = json::parse(messages_of(file).at(1).second.data);
-  EXPECT_EQ(color_calibration["width"], 24);
-  EXPECT_EQ(color_calibration["height"], 20);
+    mcap::McapReader reader(file);
+    EXPECT_EQ(reader.find_attachment("rig.calib.json")->data, read_text(calibration_file_));
+    ASSERT_EQ(reader.metadata().size(), 3u);  // the rig's, the recording's, the window
+    const mcap::Metadata stored = reader.read_metadata(reader.metadata()[2]);
+    EXPECT_EQ(stored.name, "tilth.color_window");
+    const std::map<std::string, std::string> expected{{"x", std::to_string(window.x)},
+                                                      {"y", std::to_string(window.y)},
+                                                      {"width", std::to_string(window.width)},
+                                                      {"height", std::to_string(window.height)}};
+    EXPECT_EQ(stored.values, expected);
+    const json color_calibration = json::parse(messages_of(file).at(1).second.data);
+    EXPECT_EQ(color_calibration["width"], window.width);
+    EXPECT_EQ(color_calibration["height"], window.height);
+    EXPECT_DOUBLE_EQ(color_calibration["K"][2].get<double>(), 19.5 - window.x);  // cx
+    EXPECT_DOUBLE_EQ(color_calibration["K"][5].get<double>(), 14.5 - window.y);  // cy
 
-  ASSERT_FALSE(play(file, {{"host_time", "recorded"}}).failed);
-  expect_played(PixelFormat::kBgr8, 0, frames_.size());
-  ASSERT_NE(captured_.front().raw->rig, nullptr);
-  EXPECT_EQ(to_json(*captured_.front().raw->rig), expected);
-
-  frames_ = make_frames(1, small_calibration(), 3);
-  frames_[0].color = frames_[0].color(cv::Rect(22, 0, 18, 30)).clone();
-  color_sensor_offset_ = cv::Point(22, 0);
-  const RunResult corner = record(dir_.path() / "corner.mcap", PixelFormat::kBgr8);
-  EXPECT_EQ(corner.metrics.stages[1].errors, 1u);  // the frame refused (on_error: skip)
-  // The message is RecordedColorWindow's, as image_folder_writer_test checks whole.
-  mcap::McapReader empty(dir_.path() / "corner.mcap");
-  ASSERT_TRUE(empty.statistics());
-  EXPECT_EQ(empty.statistics()->message_count, 0u);
-  EXPECT_EQ(json::parse(empty.find_attachment("rig.calib.json")->data),
-            json::parse(read_text(calibration_file_)));  // an empty recording keeps its rig
+    ASSERT_FALSE(play(file, {{"host_time", "recorded"}}).failed);
+    expect_played(PixelFormat::kBgr8, 0, frames_.size());
+    for (const Captured& played : captured_) {
+      EXPECT_EQ(played.color->sensor_offset, window.tl());
+      ASSERT_NE(played.raw->rig, nullptr);
+      EXPECT_EQ(played.raw->rig->color.width, 40);  // the whole image's calibration
+    }
+  }
 }
 
+// The window is in log time, the host capture times, here twice as far apart as the
+// device times.
 TEST_F(McapStagesTest, SeeksByLogTimeWithoutReadingTheChunksBefore) {
   frames_ = make_frames(10, small_calibration(), 3);
   for (std::size_t i = 0; i < frames_.size(); ++i) {
@@ -361,7 +359,7 @@ TEST_F(McapStagesTest, DeviceLogTimesPlayAsHostTimes) {
     EXPECT_EQ(message.log_time, static_cast<std::uint64_t>(stamp_of(topic, message))) << topic;
   }
   mcap::McapReader reader(file);
-  EXPECT_EQ(reader.read_metadata(reader.metadata()[0]).values.at("log_time"), "device");
+  EXPECT_EQ(reader.read_metadata(reader.metadata()[1]).values.at("log_time"), "device");
 
   ASSERT_FALSE(play(file, {{"host_time", "recorded"}}).failed);
   for (TestFrame& frame : frames_) frame.host_timestamp_ns = frame.depth_timestamp_ns;

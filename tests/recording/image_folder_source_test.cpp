@@ -231,6 +231,34 @@ TEST_F(ImageFolderSourceTest, RecordingJsonErrorsNameTheFieldAndWhatWasExpected)
   EXPECT_EQ(start_failure(), json_file() + ":/colour_format: no such field (misspelt?)");
 }
 
+// color_window must be a window inside the calibration's colour image, and the colour
+// PNGs its size.
+TEST_F(ImageFolderSourceTest, AColourWindowIsCheckedAgainstTheCalibrationAndThePngs) {
+  record(1);
+  const std::string expected =
+      ":/color_window: expected {\"x\", \"y\", \"width\", \"height\"} in pixels, inside "
+      "the calibration's 40x30 px colour image, got ";
+  for (const auto& [window, got] : std::vector<std::pair<json, std::string>>{
+           {json{{"x", 30}, {"y", 0}, {"width", 20}, {"height", 8}},
+            R"({"height":8,"width":20,"x":30,"y":0})"},
+           {json{{"x", -1}, {"y", 0}, {"width", 20}, {"height", 8}},
+            R"({"height":8,"width":20,"x":-1,"y":0})"},
+           {json{{"x", 0}, {"y", 0}, {"width", 20}}, R"({"width":20,"x":0,"y":0})"},
+           {json{{"x", 0}, {"y", 0}, {"width", 0}, {"height", 8}},
+            R"({"height":8,"width":0,"x":0,"y":0})"},
+           {json::array({0, 0, 20, 8}), "[0,0,20,8]"}}) {
+    edit_recording_json([&](json& d) { d["color_window"] = window; });
+    EXPECT_EQ(start_failure(), json_file() + expected + got);
+  }
+  // A window inside the image, but the PNGs are the whole image.
+  edit_recording_json([](json& d) {
+    d["color_window"] = {{"x", 4}, {"y", 2}, {"width", 20}, {"height", 8}};
+  });
+  const RunResult result = run(replay_graph(folder_));
+  EXPECT_NE(result.failure.find("(color_window in recording.json)"), std::string::npos)
+      << result.failure;
+}
+
 // The last "color_format" was kept: the frames were read as Bayer mosaics.
 TEST_F(ImageFolderSourceTest, RecordingJsonWithADuplicateKeyIsRefused) {
   record(1);

@@ -204,57 +204,76 @@ TEST_F(ImageFolderWriterTest, Mono8CannotBeRecorded) {
                            "(stored as bgr8) or a Bayer mosaic"));
 }
 
-// The first frame fixes color_format; a frame in another format is refused before any of
-// its files is written.
 // A camera reading out a window of its colour sensor: the recording holds the window's
-// pixels and the window's calibration, so that replay registers them as the live graph
-// did; a frame of another window is refused, and a window whose calibration the reader
-// would refuse (the principal point outside it) is named before its frame is written.
-TEST_F(ImageFolderWriterTest, AColourWindowIsRecordedWithItsCalibration) {
-  frames_ = make_frames(3, small_calibration(), 3);
-  const cv::Rect window(10, 6, 24, 20);  // wide enough for the 1-degree field of view
-  for (TestFrame& frame : frames_) {
-    feed_.push_back(feed_of(frame, PixelFormat::kBgr8));
-    feed_.back().color.pixels = frame.color(window).clone();
-    feed_.back().color.sensor_offset = window.tl();
-    frame.color = frame.color(window).clone();
+// pixels, the rig's calibration as given and the window in recording.json, and replay
+// gives each image its place on the sensor again, so that it registers as live; a window
+// off the image's centre records as well; a frame of another window is refused.
+TEST_F(ImageFolderWriterTest, AColourWindowIsRecordedAndReplayedWhereItLies) {
+  for (const cv::Rect& window : {cv::Rect(10, 6, 24, 20), cv::Rect(30, 0, 10, 8)}) {
+    SCOPED_TRACE(window_text(window));
+    frames_ = make_frames(3, small_calibration(), 3);
+    feed_.clear();
+    for (TestFrame& frame : frames_) {
+      feed_.push_back(feed_of(frame, PixelFormat::kBgr8));
+      feed_.back().color.pixels = frame.color(window).clone();
+      feed_.back().color.sensor_offset = window.tl();
+      frame.color = frame.color(window).clone();
+    }
+    const fs::path folder = dir_.path() / ("window" + std::to_string(window.x));
+    const RunResult result = run(feed_graph(folder, {{"calibration", calibration_file_.string()}}));
+    ASSERT_FALSE(result.failed) << result.failure;
+    EXPECT_EQ(read_text(folder / "rig.calib.json"), read_text(calibration_file_));
+    const json stored = {
+        {"x", window.x}, {"y", window.y}, {"width", window.width}, {"height", window.height}};
+    EXPECT_EQ(json::parse(read_text(folder / "recording.json"))["color_window"], stored);
+    expect_recording_holds_frames(folder, PixelFormat::kBgr8);
+    for (const Captured& replayed : captured_) {
+      EXPECT_EQ(replayed.color->sensor_offset, window.tl());
+    }
   }
-  const RunResult result = run(feed_graph(copy_, {{"calibration", calibration_file_.string()}}));
-  ASSERT_FALSE(result.failed) << result.failure;
-  json expected = to_json(parse_calibration(small_calibration(), "small"));
-  expected["color_camera"]["width"] = 24;
-  expected["color_camera"]["height"] = 20;
-  expected["color_camera"]["cx"] = 19.5 - 10;
-  expected["color_camera"]["cy"] = 14.5 - 6;
-  EXPECT_EQ(json::parse(read_text(copy_ / "rig.calib.json")), expected);
-  expect_recording_holds_frames(copy_, PixelFormat::kBgr8);
 
+  const cv::Rect window(10, 6, 24, 20);
   frames_ = make_frames(2, small_calibration(), 3);
   feed_.clear();
   for (const TestFrame& frame : frames_) feed_.push_back(feed_of(frame, PixelFormat::kBgr8));
   feed_[0].color.pixels = frames_[0].color(window).clone();
   feed_[0].color.sensor_offset = window.tl();
   feed_[1].color.sensor_offset = cv::Point(0, 0);
-  const fs::path changed = dir_.path() / "changed";
-  EXPECT_EQ(run(feed_graph(changed, {{"calibration", calibration_file_.string()}})).failure,
+  EXPECT_EQ(run(feed_graph(dir_.path() / "changed", {{"calibration", calibration_file_.string()}}))
+                .failure,
             writer_failure("4 (sequence 1): color: the sensor's 40x30 px at (0, 0); expected "
-                           "the sensor's 24x20 px at (10, 6) as in the first frame (a "
-                           "recording has one colour window)"));
+                           "24x20 px at (10, 6) as in the first frame (a recording has one "
+                           "colour window)"));
 
   feed_.resize(1);
-  feed_[0].color.pixels = frames_[0].color(cv::Rect(22, 0, 18, 30)).clone();
-  feed_[0].color.sensor_offset = cv::Point(22, 0);
-  const fs::path corner = dir_.path() / "corner";
-  EXPECT_EQ(
-      run(feed_graph(corner, {{"calibration", calibration_file_.string()}})).failure,
-      writer_failure("3 (sequence 0): color: the calibration of the sensor's 18x30 px at (22, 0) "
-                     "cannot be recorded: " +
-                     calibration_file_.string() +
-                     ", colour window 18x30 px at (22, 0):/color_camera/cx: expected a number in "
-                     "[-0.5, 17.5] px: inside the 18-px width, got -2.5"));
-  EXPECT_FALSE(fs::exists(corner / "color" / "000003.png"));
+  feed_[0].color.pixels = frames_[0].color(window).clone();
+  feed_[0].color.sensor_offset = cv::Point(20, 20);
+  EXPECT_EQ(run(feed_graph(dir_.path() / "outside", {{"calibration", calibration_file_.string()}}))
+                .failure,
+            writer_failure("3 (sequence 0): color: the sensor's 24x20 px at (20, 20) is not "
+                           "inside the calibration's 40x30 px colour image"));
 }
 
+// A first frame refused after its window was looked at (here for its mask) leaves the
+// recording's window to the first frame written.
+TEST_F(ImageFolderWriterTest, ARefusedFirstFrameDoesNotFixTheColourWindow) {
+  frames_ = make_frames(2, small_calibration(), 3);
+  feed_.push_back(feed_of(frames_[0], PixelFormat::kBgr8));
+  feed_[0].color.pixels = frames_[0].color(cv::Rect(10, 6, 24, 20)).clone();
+  feed_[0].color.sensor_offset = cv::Point(10, 6);
+  feed_[0].truth->residue_mask = cv::Mat(1, 1, CV_8UC1);
+  feed_.push_back(feed_of(frames_[1], PixelFormat::kBgr8));
+  const RunResult result =
+      run(feed_graph(copy_, {{"calibration", calibration_file_.string()}}, true, "skip"));
+  EXPECT_FALSE(result.failed);
+  EXPECT_EQ(result.metrics.stages[1].errors, 1u);
+  EXPECT_FALSE(json::parse(read_text(copy_ / "recording.json")).contains("color_window"));
+  frames_.erase(frames_.begin());
+  expect_recording_holds_frames(copy_, PixelFormat::kBgr8);
+}
+
+// The first frame fixes color_format; a frame in another format is refused before any of
+// its files is written.
 TEST_F(ImageFolderWriterTest, ColorFormatMustNotChange) {
   frames_ = make_frames(2, small_calibration(), 1);
   feed_.push_back(feed_of(frames_[0], PixelFormat::kBayerBggr8));

@@ -2,6 +2,7 @@
 
 #include "color/color_conversion.h"
 #include "in_process_graph.h"
+#include "tilth/calibration.h"
 #include "tilth/error.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/raw_tof_frame.h"
@@ -30,8 +31,16 @@ class PairLooker final : public Sink {
   void consume(const Frame& frame) override {
     if (done_) return;
     const auto& intensity = frame.input<RawTofFrame>(kIntensity).gray;
-    if (!on_pair_({frame.info().frame_id, intensity.clone(),
-                   bgr_or_gray(frame.input<ColorImage>(kColor))})) {
+    const ColorImage& color = frame.input<ColorImage>(kColor);
+    // A calibration is of the whole image; a window lying at the sensor's corner cannot be
+    // told from it here.
+    if (color.sensor_offset && *color.sensor_offset != cv::Point()) {
+      throw Error("the colour images are a window of the sensor (" +
+                  window_text(color.sensor_window()) +
+                  "); calibrate with the whole image: OffsetX and OffsetY 0, Width and Height "
+                  "the sensor's");
+    }
+    if (!on_pair_({frame.info().frame_id, intensity.clone(), bgr_or_gray(color)})) {
       done_ = true;
       graph_.stop();
     }

@@ -6,6 +6,6 @@
 
 namespace tilth {
 
-inline constexpr std::uint32_t kAbiVersion = 5;
+inline constexpr std::uint32_t kAbiVersion = 6;
 
 }  // namespace tilth

@@ -61,6 +61,8 @@ void save_calibration(const RigCalibration& calibration, const std::filesystem::
 // moved by the window's corner, its size the window's. Throws tilth::Error when the window
 // is not inside the calibrated colour image.
 RigCalibration with_color_window(const RigCalibration& rig, const cv::Rect& window);
+// "736x512 px at (368, 256)": a window, as messages name it.
+std::string window_text(const cv::Rect& window);
 
 std::string_view to_string(DepthMeasure measure);
 
