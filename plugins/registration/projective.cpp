@@ -256,7 +256,19 @@ struct WindowGeometry {
   std::shared_ptr<const RigCalibration> rig;  // the calibration it was made from
   cv::Rect window;
   std::shared_ptr<const Geometry> geometry;
+  bool warned = false;  // that the window is too small for the region
 };
+
+// The pixels of `region` whose colour lies outside the colour image.
+int outside_color(const RegisteredColor& out, const cv::Rect& region) {
+  int count = 0;
+  for (int v = region.y; v < region.y + region.height; ++v) {
+    const std::uint8_t* status = out.status.ptr<std::uint8_t>(v) + region.x;
+    count +=
+        static_cast<int>(std::count(status, status + region.width, RegisteredColor::kOutsideColor));
+  }
+  return count;
+}
 
 class ProjectiveRegistration final : public Transform {
  public:
@@ -292,11 +304,28 @@ class ProjectiveRegistration final : public Transform {
       register_nearest(map, geometry.cells, depth.mm, nearest_pixels(color.pixels, color.format),
                        occlusion_tolerance_mm_, rows, *scratch, *out);
     }
+    if (color.sensor_offset) warn_if_window_too_small(*out, depth.mm.size(), geometry_held);
     frame.set_output(0, std::move(out));
   }
 
  private:
   using Used = FrameCalibration<Geometry>::Used;
+
+  // Once per window: the region has pixels whose colour lies outside the window, as when
+  // the ground comes nearer or goes farther than the window was chosen for.
+  void warn_if_window_too_small(const RegisteredColor& out, cv::Size depth_size,
+                                const std::shared_ptr<const Geometry>& geometry) {
+    const cv::Rect region = roi_.on(depth_size);
+    const int outside = outside_color(out, region);
+    if (outside == 0) return;
+    std::lock_guard lock(window_mutex_);
+    if (window_.geometry != geometry || window_.warned) return;
+    window_.warned = true;
+    log_.warning(std::to_string(outside) + " of the region's " + std::to_string(region.area()) +
+                 " px see colour outside the colour window " + window_text(window_.window) +
+                 ": is the ground nearer or farther than the window was chosen for? Widen it "
+                 "(tilth calibrate color-window); said once per window");
+  }
 
   // The calibration's geometry, or its window's when the colour image is a window of the
   // calibrated image.
@@ -311,7 +340,7 @@ class ProjectiveRegistration final : public Transform {
     if (window_.rig != used->rig || window_.window != window) {
       auto geometry = std::make_shared<const Geometry>(with_color_window(rig, window), kernels_);
       log_.info("colour images are a window of the sensor: registering with " + geometry->origin);
-      window_ = {used->rig, window, std::move(geometry)};
+      window_ = {used->rig, window, std::move(geometry), false};
     }
     return window_.geometry;
   }

@@ -34,6 +34,7 @@
 #include "source_tree.h"
 #include "tilth/error.h"
 #include "tilth/frame.h"
+#include "tilth/log.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/registered_color.h"
@@ -647,7 +648,8 @@ TEST(ProjectiveRegistration, AColourWindowGivesTheWholeImagesColoursWhereItReach
 
 // The window color_window_for gives for the chain's region and a range of ground
 // distances holds every colour pixel the registration of that region reads: a plane
-// anywhere in the range registers in the region exactly as with the whole image.
+// anywhere in the range registers in the region exactly as with the whole image; nearer,
+// the stage says the window is too small.
 TEST(ProjectiveRegistration, TheWindowARegionNeedsRegistersItAsTheWholeImage) {
   const json document = testing::paper_rig_document();
   const CalibrationFile file(document);
@@ -668,11 +670,33 @@ TEST(ProjectiveRegistration, TheWindowARegionNeedsRegistersItAsTheWholeImage) {
     EXPECT_EQ(cv::countNonZero(part->status(region) != RegisteredColor::kValid), 0);
     EXPECT_EQ(cv::norm(whole->bgr(region), part->bgr(region), cv::NORM_INF), 0.0);
   }
-  // Beyond the range the region's far side leaves the window.
-  const auto too_near =
-      register_color(*stage, plane_depth(rig, rays, 300, {0, 0, 1}), sensor(window).clone(),
-                     PixelFormat::kBgr8, nullptr, window.tl());
-  EXPECT_GT(cv::countNonZero(too_near->status(region) == RegisteredColor::kOutsideColor), 0);
+  // Nearer than the range, the region's edge sees colour outside the window: said once.
+  std::vector<std::string> warnings;
+  const LogHandler previous =
+      set_log_handler([&](LogLevel level, std::string_view, std::string_view text) {
+        if (level == LogLevel::kWarning) warnings.emplace_back(text);
+      });
+  const cv::Rect measured = roi.on(cv::Size(640, 480));
+  for (int repeat = 0; repeat < 2; ++repeat) {
+    const auto too_near =
+        register_color(*stage, plane_depth(rig, rays, 300, {0, 0, 1}), sensor(window).clone(),
+                       PixelFormat::kBgr8, nullptr, window.tl());
+    const int outside =
+        cv::countNonZero(too_near->status(measured) == RegisteredColor::kOutsideColor);
+    // The region's last column, u 479, is seen at colour u 1000 / 509.935 (479 - 313.05) +
+    // 639.5 + 45000 / 323.97 = 1103.8, past the window's last pixel, 1103: its 240 pixels.
+    EXPECT_EQ(outside, 240);
+    if (repeat == 0) {
+      ASSERT_EQ(warnings.size(), 1u);
+      EXPECT_EQ(warnings[0], std::to_string(outside) +
+                                 " of the region's 76800 px see colour outside the colour window "
+                                 "736x512 px at (368, 256): is the ground nearer or farther than "
+                                 "the window was chosen for? Widen it (tilth calibrate "
+                                 "color-window); said once per window");
+    }
+  }
+  set_log_handler(previous);
+  EXPECT_EQ(warnings.size(), 1u);
 }
 
 // The 2x2 tile of each mosaic, row by row.
