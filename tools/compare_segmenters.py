@@ -13,7 +13,9 @@ trained on the masks and on labels from depth. Every segmenter is scored the sam
 its mask undilated and not despeckled (the decision itself), over the region the chain
 segments (`middle_half`), against the truth's soil and residue pixels, a pixel called
 unknown counting as not residue (sinks.evaluation). The table is residue IoU per
-recording, and pooled over all pixels.
+recording, and pooled over all pixels. One column, classifier_field, is trained on the
+held-out recording's frames too, by their labels from depth (never its masks): a field's
+own unlabelled recordings, as `tilth train-segmenter --labels depth` is for.
 
     python3 tools/compare_segmenters.py --recordings /tmp/segmenters > table.md
 
@@ -42,15 +44,21 @@ RULES = [
     ("self_trained", "a forest learnt online from the recording's depth labels",
      {"segment.type": "segmentation.self_trained", "segment.training": "inline"}),
 ]
-# name, what it is, train-segmenter options, the stage, its model file's extension.
+# name, what it is, train-segmenter options, the stage, its model file's extension, and
+# whether the held-out recording's frames join the training (by their depth labels only:
+# its masks are never trained on).
 LEARNED = [
     ("classifier", "pixel classifier (texture, forest) trained on the masks", [],
-     "segmentation.pixel_classifier", ".yml.gz"),
+     "segmentation.pixel_classifier", ".yml.gz", False),
     ("classifier_depth", "the same trained on labels from depth", ["--labels", "depth"],
-     "segmentation.pixel_classifier", ".yml.gz"),
-    ("cnn", "the U-Net trained on the masks", ["--model", "cnn"], "segmentation.cnn", ".onnx"),
+     "segmentation.pixel_classifier", ".yml.gz", False),
+    ("classifier_field", "the same trained on labels from depth with the held-out "
+     "recording's own frames: a field's unlabelled recordings", ["--labels", "depth"],
+     "segmentation.pixel_classifier", ".yml.gz", True),
+    ("cnn", "the U-Net trained on the masks", ["--model", "cnn"], "segmentation.cnn", ".onnx",
+     False),
     ("cnn_depth", "the same trained on labels from depth", ["--model", "cnn", "--labels", "depth"],
-     "segmentation.cnn", ".onnx"),
+     "segmentation.cnn", ".onnx", False),
 ]
 # The same scoring for every segmenter.
 SCORED = {"segment.dilation_px": 0, "segment.speckle_px": 0, "segment.roi": "middle_half"}
@@ -73,12 +81,12 @@ def simulate(tilth, folder, preset, args, log):
 
 
 def train(tilth, folder, held, recordings, learned, args, log):
-    name, _, options, _, extension = learned
-    model = os.path.join(folder, "models", "%s-without-%s%s" % (
-        name, os.path.basename(held), extension))
+    name, _, options, _, extension, with_held = learned
+    model = os.path.join(folder, "models", "%s-%s-%s%s" % (
+        name, "with" if with_held else "without", os.path.basename(held), extension))
     if not os.path.exists(model):
-        others = [r for r in recordings if r != held]
-        command = [tilth, "train-segmenter", *others, "--test", held, "--out", model, *options]
+        trained = [r for r in recordings if with_held or r != held]
+        command = [tilth, "train-segmenter", *trained, "--test", held, "--out", model, *options]
         if "cnn" in options:
             command += ["--epochs", str(args.cnn_epochs), "--steps", str(args.cnn_steps)]
         run(command, log)
