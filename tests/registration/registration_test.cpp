@@ -66,6 +66,15 @@ json rotation(double x_deg, double y_deg, double z_deg) {
   return {{r(0, 0), r(0, 1), r(0, 2)}, {r(1, 0), r(1, 1), r(1, 2)}, {r(2, 0), r(2, 1), r(2, 2)}};
 }
 
+// The paper's rig with the colour camera turned about every axis and moved diagonally:
+// a box on a plane then hides plane in rows and columns other than its own.
+json rotated_diagonal_rig() {
+  json document = testing::paper_rig_document();
+  document["depth_to_color"]["R"] = rotation(3, -4, 2);
+  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  return document;
+}
+
 std::unique_ptr<Transform> make_registration(const fs::path& calibration,
                                              const std::string& interpolation = "nearest",
                                              double occlusion_tolerance_mm = 10.0,
@@ -504,9 +513,7 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheColourCameraOnTheOt
 TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedForARotatedDiagonalRig) {
   // The box top's samples reach the colour image as a turned lattice; z-buffer cells one
   // depth pixel wide left holes in it here, and the plane behind them got the box's colour.
-  json document = testing::paper_rig_document();
-  document["depth_to_color"]["R"] = rotation(3, -4, 2);
-  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  const json document = rotated_diagonal_rig();
   expect_occlusion_found(occlusion_by_a_box(document), 1200);
 }
 
@@ -522,9 +529,7 @@ TEST(ProjectiveRegistration, PlaneBehindABoxIsOccludedWithTheEpipoleInsideTheIma
 TEST(ProjectiveRegistration, ARegionIsRegisteredAsInTheWholeImage) {
   // The rotated diagonal rig: the box hides plane in rows other than its own, so a band
   // that holds hidden plane but not all of the box needs the z-buffer of every row.
-  json document = testing::paper_rig_document();
-  document["depth_to_color"]["R"] = rotation(3, -4, 2);
-  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  const json document = rotated_diagonal_rig();
   const CalibrationFile file(document);
   cv::Mat hidden_mm;
   const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);
@@ -578,9 +583,7 @@ std::string process_error(Transform& stage, const cv::Mat& depth, const cv::Mat&
 //   the whole image: on the box's silhouette, within a cell (3 px here) of an occluded
 //   pixel, a point may compare with another nearest point and turn occluded or visible.
 TEST(ProjectiveRegistration, AColourWindowGivesTheWholeImagesColoursWhereItReaches) {
-  json document = testing::paper_rig_document();
-  document["depth_to_color"]["R"] = rotation(3, -4, 2);
-  document["depth_to_color"]["T_mm"] = {30.0, -35.0, 0.0};
+  const json document = rotated_diagonal_rig();
   const CalibrationFile file(document);
   cv::Mat hidden_mm;
   const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);

@@ -27,6 +27,7 @@
 #include "command_line.h"
 #include "commands.h"
 #include "framework/nearest_names.h"
+#include "number_pair.h"
 #include "rig_facts.h"
 #include "rig_solver.h"
 #include "roi/region_of_interest.h"
@@ -207,15 +208,10 @@ std::string checked_calibration_text(const RigCalibration& rig, const fs::path& 
 }
 
 cv::Size parse_board(const std::string& text) {
-  const auto x = text.find('x');
-  int columns = 0;
-  int rows = 0;
-  const char* end = text.data() + text.size();
-  const bool parsed =
-      x != std::string::npos &&
-      std::from_chars(text.data(), text.data() + x, columns).ptr == text.data() + x &&
-      std::from_chars(text.data() + x + 1, end, rows).ptr == end;
-  if (!parsed || columns < 2 || rows < 2 || columns > 100 || rows > 100) {
+  const auto board = tilth::calibrate::number_pair<int>(text, 'x');
+  const int columns = board ? board->first : 0;
+  const int rows = board ? board->second : 0;
+  if (columns < 2 || rows < 2 || columns > 100 || rows > 100) {
     throw Error(
         "--board: expected COLSxROWS, the inner corners along and across (2 to 100 "
         "each), e.g. 8x5 for a board of 9x6 squares, got '" +
@@ -504,20 +500,13 @@ int capture(const CommandLine& line) {
 
 // NEAR:FAR in mm.
 std::pair<double, double> parse_distances(const std::string& text) {
-  const auto colon = text.find(':');
-  double near_mm = 0;
-  double far_mm = 0;
-  const char* end = text.data() + text.size();
-  const bool parsed =
-      colon != std::string::npos &&
-      std::from_chars(text.data(), text.data() + colon, near_mm).ptr == text.data() + colon &&
-      std::from_chars(text.data() + colon + 1, end, far_mm).ptr == end;
-  if (!parsed || !(near_mm > 0) || !(far_mm >= near_mm)) {
+  const auto range = tilth::calibrate::number_pair<double>(text, ':');
+  if (!range || !(range->first > 0) || !(range->second >= range->first)) {
     throw Error(
         "--distance-mm: expected NEAR:FAR in mm with 0 < NEAR <= FAR (e.g. 400:700), got '" + text +
         "'");
   }
-  return {near_mm, far_mm};
+  return *range;
 }
 
 int color_window(const CommandLine& line) {

@@ -1,8 +1,8 @@
 #include "rig_facts.h"
 
-#include <charconv>
 #include <optional>
 
+#include "number_pair.h"
 #include "tilth/error.h"
 
 namespace tilth::calibrate {
@@ -10,18 +10,9 @@ namespace {
 
 // "640x480" -> {640, 480}.
 std::optional<std::pair<int, int>> parse_size(const std::string& text) {
-  const auto x = text.find('x');
-  if (x == std::string::npos) return std::nullopt;
-  int width = 0;
-  int height = 0;
-  const char* end = text.data() + text.size();
-  const auto [width_end, width_error] = std::from_chars(text.data(), text.data() + x, width);
-  const auto [height_end, height_error] = std::from_chars(text.data() + x + 1, end, height);
-  if (width_error != std::errc() || width_end != text.data() + x || height_error != std::errc() ||
-      height_end != end || width <= 0 || height <= 0) {
-    return std::nullopt;
-  }
-  return std::make_pair(width, height);
+  const auto size = number_pair<int>(text, 'x');
+  if (!size || size->first <= 0 || size->second <= 0) return std::nullopt;
+  return size;
 }
 
 void apply_size(const cli::CommandLine& line, const std::string& option, CameraIntrinsics& camera) {
