@@ -304,7 +304,7 @@ class ProjectiveRegistration final : public Transform {
       register_nearest(map, geometry.cells, depth.mm, nearest_pixels(color.pixels, color.format),
                        occlusion_tolerance_mm_, rows, *scratch, *out);
     }
-    if (color.sensor_offset) warn_if_window_too_small(*out, depth.mm.size(), geometry_held);
+    warn_if_window_too_small(*out, depth.mm.size(), geometry_held);
     frame.set_output(0, std::move(out));
   }
 
@@ -315,10 +315,14 @@ class ProjectiveRegistration final : public Transform {
   // the ground comes nearer or goes farther than the window was chosen for.
   void warn_if_window_too_small(const RegisteredColor& out, cv::Size depth_size,
                                 const std::shared_ptr<const Geometry>& geometry) {
+    // Counted only while it may still be said: not for a whole image, nor once said.
+    std::unique_lock lock(window_mutex_);
+    if (window_.geometry != geometry || window_.warned) return;
+    lock.unlock();
     const cv::Rect region = roi_.on(depth_size);
     const int outside = outside_color(out, region);
     if (outside == 0) return;
-    std::lock_guard lock(window_mutex_);
+    lock.lock();
     if (window_.geometry != geometry || window_.warned) return;
     window_.warned = true;
     log_.warning(std::to_string(outside) + " of the region's " + std::to_string(region.area()) +
