@@ -5,8 +5,8 @@ the host clock (trigger_mode host_clock, pairing triggered; docs/pairing.md), an
 comparison, free-running with the whole colour image and the cameras' own packet size
 (graphs/fake-cameras.json reads out the window the chain needs, in 8000-byte packets).
 
-    python3 bench/capture_latency.py [--seconds 20] [--rounds 1]   (as root: it adds
-                                                  loopback addresses for the cameras)
+    python3 bench/capture_latency.py [--seconds 20] [--rounds 1] [--modes MODE...]
+                                     (as root: it adds loopback addresses for the cameras)
 
 What runs, for each mode in turn: two GigE Vision camera simulators at 30 frames/s
 (640x480 Mono16 depth, a 736x512 window of 1280x1024 BayerRG8 colour, or all of it in
@@ -110,6 +110,7 @@ def main():
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--rounds", type=int, default=1,
                         help="run the modes in turn this many times (the VM's speed drifts)")
+    parser.add_argument("--modes", nargs="+", choices=list(MODES), default=list(MODES))
     parser.add_argument("--tilth", default=os.path.join(SOURCE, "build", "bin", "tilth"))
     parser.add_argument("--fake-camera",
                         default=os.path.join(SOURCE, "build", "bin", "tilth-fake-gige-camera"))
@@ -117,9 +118,9 @@ def main():
     os.environ["TILTH_FAKE_CAMERA"] = args.fake_camera
     work = tempfile.mkdtemp(prefix="tilth-latency-bench-")
     try:
-        results = {mode: ([], []) for mode in MODES}
+        results = {mode: ([], []) for mode in args.modes}
         for _ in range(args.rounds):
-            for mode in MODES:
+            for mode in args.modes:
                 ages, read_ms = run_mode(args, mode, work)
                 results[mode][0].extend(ages)
                 results[mode][1].append(read_ms)

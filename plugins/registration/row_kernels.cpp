@@ -391,9 +391,10 @@ void locate(const Addressing& addressing, const CellGrid& cells, int color_width
 
 // One point at a time: listing a vector's runs of points that share a cell costs more
 // than waiting for a neighbour's store (measured). NaN depth leaves a cell as it was.
-void keep_nearest(const CellGrid&, int count, const float* color_depth, const int* cell_indices,
-                  float* nearest_mm) {
+void keep_nearest(const CellGrid& cells, int count, const float* color_depth,
+                  const int* cell_indices, float* nearest_mm) {
   for (int i = 0; i < count; ++i) {
+    if (cell_indices[i] == cells.outside) continue;
     float& nearest = nearest_mm[cell_indices[i]];
     nearest = color_depth[i] < nearest ? color_depth[i] : nearest;
   }

@@ -70,8 +70,9 @@ struct RowKernels {
                  int color_height, int count, const float* color_u, const float* color_v,
                  const float* color_depth, int* keys, int* cell_indices);
   // nearest_mm (CellGrid::count() floats) lowered to the depth of each of `count`
-  // located points (a multiple of kRowLanes) in its cell. Points not shown have NaN
-  // depth, which leaves the outside cell as it was.
+  // located points (a multiple of kRowLanes) in its cell. Points not shown (NaN depth)
+  // are passed over: with a window of the colour sensor most of a row is not shown, and
+  // lowering their one cell again and again would chain every load to the last store.
   void (*keep_nearest)(const CellGrid& cells, int count, const float* color_depth,
                        const int* cell_indices, float* nearest_mm);
   // For `count` located points of a depth row at z_mm: status (Visibility) and, where
