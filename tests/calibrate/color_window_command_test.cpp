@@ -36,7 +36,10 @@ TEST(ColorWindowCommand, UsageErrorsSayWhatWasExpected) {
             "--distance-mm: expected NEAR:FAR in mm with 0 < NEAR <= FAR (e.g. 400:700), got "
             "'700:400'"},
            {"color-window " + rig + " --distance-mm 400:700 --step 0",
-            "--step: expected a whole number in [1, 1024], got '0'"},
+            "--step: expected a whole number in [2, 1024], got '0'"},
+           {"color-window " + rig + " --distance-mm 400:700 --step 3",
+            "--step: expected an even number of px (a Bayer mosaic keeps the pattern its pixel "
+            "format names only at even offsets), got 3"},
            {"color-window --distance-mm 400:700",
             "color-window takes RIG.calib.json and --distance-mm NEAR:FAR"},
            {"color-window " + rig + " --distance-mm 400:700 --views 3",

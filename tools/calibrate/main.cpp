@@ -118,8 +118,8 @@ constexpr const char* kUsage = R"(usage: tilth calibrate COMMAND ARGS
       and recordings use the window's calibration (docs/cameras.md).
         --roi R         the chain's roi: middle_half (default), image, or
                         {"x": X, "y": Y, "width": W, "height": H} in depth pixels
-        --step N        corner and size in multiples of N px (default 16; the
-                        camera's Width, Height, OffsetX and OffsetY increments)
+        --step N        corner and size in multiples of N px, even (default 16;
+                        the camera's Width, Height, OffsetX and OffsetY increments)
 
 What neither the views nor Basler's file say (solve and import):
   --base RIG.calib.json   a calibration of the same rig whose other fields are kept
@@ -523,7 +523,13 @@ int color_window(const CommandLine& line) {
   nlohmann::json roi_value = "middle_half";
   try {
     range = parse_distances(*distances);
-    step = static_cast<int>(line.count("--step", 1, 1024).value_or(16));
+    step = static_cast<int>(line.count("--step", 2, 1024).value_or(16));
+    if (step % 2 != 0) {
+      throw Error(
+          "--step: expected an even number of px (a Bayer mosaic keeps the pattern "
+          "its pixel format names only at even offsets), got " +
+          std::to_string(step));
+    }
     if (const auto roi = line.value("--roi")) {
       roi_value = nlohmann::json::accept(*roi) ? nlohmann::json::parse(*roi) : nlohmann::json(*roi);
     }
