@@ -60,10 +60,10 @@ class Scenario:
         # as tilth ab names the recording of its folder
         self.name = preset if rig == "paper" else "%s_%s_rig" % (preset, rig)
 
-    def simulate(self, tilth, folder, frames):
+    def simulate(self, tilth, folder, frames, seed):
         command = [tilth, "simulate", folder, "--preset", self.preset,
                    "--frames", str(self.frames or frames), "--calibration", RIGS[self.rig],
-                   "--color-format", self.color_format]
+                   "--color-format", self.color_format, "--seed", str(seed)]
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
 
 
@@ -139,7 +139,7 @@ def run_matrix(args, work):
         folder = os.path.join(args.recordings or work, scenario.name)
         if not os.path.isdir(folder):
             print("accuracy.py: simulating %s" % scenario.name, file=sys.stderr)
-            scenario.simulate(args.tilth, folder, args.frames)
+            scenario.simulate(args.tilth, folder, args.frames, args.seed)
         folders.append(folder)
     report = os.path.join(work, "ab")
     subprocess.run([args.tilth, "ab", *folders, "--variants", args.variants, "--out", report,
@@ -158,10 +158,12 @@ def print_report(args, listed, variants, cells):
     print("# Accuracy on simulated field scenarios\n")
     options = (" --small" if args.small else "") + (
         " --frames %d" % args.frames if args.frames != (3 if args.small else 8) else "")
+    options += " --seed %d" % args.seed if args.seed != 1 else ""
     print("Produced by `python3 tools/accuracy.py%s > docs/accuracy.md` (after building):"
           % options)
     print("each scenario is a scene preset of docs/simulator.md, seen by a rig (`calib/`) with")
-    print("a colour format, simulated (seed 1) into an image-folder recording; `tilth ab` runs")
+    print("a colour format, simulated (seed %d) into an image-folder recording; `tilth ab` runs"
+          % args.seed)
     print("every variant of `graphs/ab/segmentation-variants.json` over all of them.")
     print("`field` is the chain as it is (`graphs/measurement-chain.json`); `paper` is the")
     print("paper's method; the others change only the segmentation of `field`. Errors are")
@@ -213,6 +215,9 @@ def main():
     parser.add_argument("--small", action="store_true", help="the CI subset, fewer frames")
     parser.add_argument("--check", metavar="VARIANT",
                         help="exit 1 unless VARIANT meets the bounds on every scenario")
+    parser.add_argument("--seed", type=int, default=1,
+                        help="the simulator's seed: other scenes of the same presets (keep "
+                        "their recordings apart)")
     parser.add_argument("--variants", default=VARIANTS)
     parser.add_argument("--recordings", metavar="DIR",
                         help="keep the simulated recordings here, and reuse those already here")

@@ -6,7 +6,8 @@
 //   with that tilt taken out, from their median near the tool point to the nearest mode
 //   (mean shift) ──► a quadric surface fitted to the soil points within the outlier
 //   threshold of it (weighted least squares with Tukey's biweight, re-selected until it
-//   settles) ──► distance at tool_point,
+//   settles) ──► steps in its residuals (min_step_mm)? ── yes ──► the points on the tool's
+//   side of them, fitted again ──► distance at tool_point,
 //   tilt, spread = weighted RMS of the inlier residuals
 //
 // Why in this order. A step in the ground shows as two levels with the same tilt; a plane
@@ -14,7 +15,8 @@
 // slopes (a step is a slope only along its edge) and the level found by its mode near the
 // tool keep the fit on the level the tool stands on. The quadric follows the curvature of
 // ridges and furrows, so the fit can weigh soil from farther away (`neighbourhood_mm`) and
-// average out clods and small relief.
+// average out clods and relief; cut at the steps (ground_steps.h), it can do so without
+// averaging a step's two levels.
 //
 // `neighbourhood_mm` weights each point by a Gaussian of its distance from the tool point
 // across the ground; 0 weighs all points alike. `tool_area_mm` is the scale of the soil
@@ -26,7 +28,7 @@
 // +x, the right).
 //
 //   "estimate": {"type": "estimation.ground_plane",
-//                "params": {"tool_point": [0, 120], "neighbourhood_mm": 40,
+//                "params": {"tool_point": [0, 120], "neighbourhood_mm": 100, "min_step_mm": 2,
 //                           "tool_area_mm": 10, "outlier_threshold_mm": 3}}
 #include <algorithm>
 #include <array>
@@ -40,6 +42,7 @@
 
 #include "camera_geometry/lens_model.h"
 #include "estimators.h"
+#include "ground_steps.h"
 #include "plausibility.h"
 #include "soil_region.h"
 #include "tilth/calibration.h"
@@ -69,6 +72,10 @@ const double kNegligibleExponent = -std::log(kNegligibleWeight);
 // The quadric's coordinates are (X, Y) from the tool point in units of kQuadricScaleMm,
 // so that its normal equations are well conditioned.
 constexpr double kQuadricScaleMm = 100.0;
+// The step search looks at every kStepSampleStep-th soil point: thousands, not all.
+constexpr std::size_t kStepSampleStep = 4;
+// At most this many steps are cut off, the highest first.
+constexpr int kMaxSteps = 3;
 
 struct GridPixel {
   int row;
@@ -297,6 +304,7 @@ class GroundPlaneEstimator final : public Transform {
         neighbourhood_mm_(context.params.number("neighbourhood_mm")),
         tool_area_mm_(context.params.number("tool_area_mm")),
         min_inlier_fraction_(context.params.number("min_inlier_fraction")),
+        min_step_mm_(context.params.number("min_step_mm")),
         gates_(context.params),
         calibration_(
             context.params, context.log,
@@ -358,12 +366,7 @@ class GroundPlaneEstimator final : public Transform {
       if (weight < kNegligibleWeight) continue;
       points.push_back({x, y, z, weight, nearness(x, y, tool_area_mm_)});
     }
-    // No soil within the tool area (residue covers it): the soil nearest the tool, by the
-    // fit's weights, decides the level.
-    if (std::none_of(points.begin(), points.end(),
-                     [](const SoilPoint& point) { return point.vote >= kNegligibleWeight; })) {
-      for (SoilPoint& point : points) point.vote = point.weight;
-    }
+    vote_near_the_tool(points);
     const std::optional<Tilt> tilt = ground_tilt(grid, sampling.grid_columns);
     if (!tilt || points.size() < 6) {
       out.invalidate(InvalidCause::kTooLittleSoil,
@@ -371,15 +374,20 @@ class GroundPlaneEstimator final : public Transform {
                      "'stride')");
       return;
     }
-    Quadric surface(tool_point_mm_, tool_level(points, *tilt, threshold_mm_), *tilt);
-    for (int refit = 0; refit < kMaxRefits; ++refit) {
-      const double before = surface.depth_at_origin();
-      if (!surface.refit(points, threshold_mm_)) {
-        out.invalidate(InvalidCause::kNotOneSurface,
-                       "no surface fits the soil points (too few inliers, or all on a line)");
+    std::optional<Quadric> surface = fitted_surface(points, *tilt);
+    if (surface && min_step_mm_ > 0 && cut_at_steps(*surface, points)) {
+      if (points.size() < 6) {
+        out.invalidate(InvalidCause::kTooLittleSoil,
+                       "too few soil points on the tool's side of a step in the ground");
         return;
       }
-      if (std::abs(surface.depth_at_origin() - before) < kLevelSettledMm) break;
+      vote_near_the_tool(points);
+      surface = fitted_surface(points, *tilt);
+    }
+    if (!surface) {
+      out.invalidate(InvalidCause::kNotOneSurface,
+                     "no surface fits the soil points (too few inliers, or all on a line)");
+      return;
     }
 
     double inlier_weight = 0.0;
@@ -388,7 +396,7 @@ class GroundPlaneEstimator final : public Transform {
     double inlier_votes = 0.0;
     for (const SoilPoint& point : points) {
       votes += point.vote;
-      const double residual_mm = surface.residual_mm(point);
+      const double residual_mm = surface->residual_mm(point);
       if (std::abs(residual_mm) > threshold_mm_) continue;
       inlier_votes += point.vote;
       inlier_weight += point.weight;
@@ -403,7 +411,7 @@ class GroundPlaneEstimator final : public Transform {
                          one_decimal(100.0 * min_inlier_fraction_) + " %");
       return;
     }
-    const double depth_at_tool = surface.depth_at_origin();
+    const double depth_at_tool = surface->depth_at_origin();
     if (!std::isfinite(depth_at_tool) || depth_at_tool <= 0) {
       out.invalidate(InvalidCause::kOutOfRange,
                      "the fitted surface does not lie in front of the camera at the tool point");
@@ -411,10 +419,55 @@ class GroundPlaneEstimator final : public Transform {
     }
     out.spread_mm = std::sqrt(squares / inlier_weight);
     out.distance_mm = depth_at_tool - camera.z_offset_mm;
-    out.tilt_x_deg = degrees(std::atan(surface.slope_y_at_origin()));
-    out.tilt_y_deg = degrees(std::atan(surface.slope_x_at_origin()));
+    out.tilt_x_deg = degrees(std::atan(surface->slope_y_at_origin()));
+    out.tilt_y_deg = degrees(std::atan(surface->slope_x_at_origin()));
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
+  }
+
+  // The quadric on the tool's level, re-fitted until it settles; nullopt when the points
+  // do not determine one.
+  std::optional<Quadric> fitted_surface(const std::vector<SoilPoint>& points,
+                                        const Tilt& tilt) const {
+    Quadric surface(tool_point_mm_, tool_level(points, tilt, threshold_mm_), tilt);
+    for (int refit = 0; refit < kMaxRefits; ++refit) {
+      const double before = surface.depth_at_origin();
+      if (!surface.refit(points, threshold_mm_)) return std::nullopt;
+      if (std::abs(surface.depth_at_origin() - before) < kLevelSettledMm) break;
+    }
+    return surface;
+  }
+
+  // Leaves only the points on the tool point's side of the steps in the ground that the
+  // residuals of `surface` show (ground_steps.h); false when there are none.
+  bool cut_at_steps(const Quadric& surface, std::vector<SoilPoint>& points) const {
+    thread_local std::vector<LevelPoint> sample;
+    sample.clear();
+    for (std::size_t i = 0; i < points.size(); i += kStepSampleStep) {
+      sample.push_back({points[i].x - tool_point_mm_[0], points[i].y - tool_point_mm_[1],
+                        surface.residual_mm(points[i])});
+    }
+    bool cut = false;
+    for (int found = 0; found < kMaxSteps; ++found) {
+      const std::optional<GroundStep> step = highest_step(sample, min_step_mm_);
+      if (!step) break;
+      cut = true;
+      const auto beyond = [&](double x, double y) { return step->cuts_off(x, y); };
+      std::erase_if(sample, [&](const LevelPoint& p) { return beyond(p.x_mm, p.y_mm); });
+      std::erase_if(points, [&](const SoilPoint& p) {
+        return beyond(p.x - tool_point_mm_[0], p.y - tool_point_mm_[1]);
+      });
+    }
+    return cut;
+  }
+
+  // No soil within the tool area (residue covers it): the soil nearest the tool, by the
+  // fit's weights, decides the level.
+  static void vote_near_the_tool(std::vector<SoilPoint>& points) {
+    if (std::none_of(points.begin(), points.end(),
+                     [](const SoilPoint& point) { return point.vote >= kNegligibleWeight; })) {
+      for (SoilPoint& point : points) point.vote = point.weight;
+    }
   }
 
   // A Gaussian (sigma `scale_mm`) of a point's distance across the ground from the tool
@@ -435,6 +488,7 @@ class GroundPlaneEstimator final : public Transform {
   const double neighbourhood_mm_;
   const double tool_area_mm_;
   const double min_inlier_fraction_;
+  const double min_step_mm_;
   const PlausibilityGates gates_;
   FrameCalibration<Sampling> calibration_;
 };
@@ -476,6 +530,11 @@ StageDescriptor describe_ground_plane() {
           .range(0, 1)
           .describe("below this fraction of the soil points (weighed by their votes) on the "
                     "tool's surface the measurement is invalid"),
+      ParamSpec::number("min_step_mm", 0.0)
+          .range(0, 100)
+          .in_unit("mm")
+          .describe("the level jumping by this much along a straight line across the ground "
+                    "is a step: the fit keeps to the tool's side of it; 0 = no search"),
       ParamSpec::integer("stride", 4)
           .range(1, 64)
           .in_unit("px")

@@ -56,11 +56,9 @@ GroundDistance fit_plane(const cv::Mat& soil_mm, const json& params = json::obje
 
 // The estimation's parameters in graphs/measurement-chain.json.
 json chain_params() {
-  return {{"neighbourhood_mm", 40},
-          {"tool_area_mm", 10},
-          {"stride", 2},
-          {"outlier_threshold_mm", 3},
-          {"min_inlier_fraction", 0.35}};
+  return {{"neighbourhood_mm", 100},   {"min_step_mm", 2},
+          {"tool_area_mm", 10},        {"stride", 2},
+          {"outlier_threshold_mm", 3}, {"min_inlier_fraction", 0.35}};
 }
 
 const DepthCameraCalibration& paper_camera() {
@@ -185,6 +183,41 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
   const GroundDistance beyond = fit_plane(depth, beside_the_step);
   ASSERT_TRUE(beyond.valid) << beyond.invalid_reason;
   EXPECT_NEAR(beyond.distance_mm, testing::plane_distance_at(far_level, 40.0, 0.0), 0.3);
+}
+
+// A 4 mm step crosses the ground 30 mm from the tool point, turned 25 deg from the image's
+// rows, and the far level holds most of the region. Fitted over 100 mm around the tool,
+// the ground is read on the tool's level: within 0.2 mm of it (some 2 000 points on the
+// tool's side, 1 mm noise: a standard error of a few hundredths). Without the step search
+// the same fit takes in the far level beyond the outlier threshold's reach, and is more
+// than 0.5 mm off.
+TEST(GroundPlane, WideFitKeepsToTheToolsSideOfAStep) {
+  GroundScene near_level;
+  near_level.noise_mm = 1.0;
+  GroundScene far_level = near_level;
+  far_level.distance_mm += 4.0;
+  far_level.seed = 2;
+  const DepthCameraCalibration& camera = paper_camera();
+  cv::Mat depth = testing::render(near_level, camera);
+  const cv::Mat far = testing::render(far_level, camera);
+  const double c = std::cos(25.0 * CV_PI / 180.0), s = std::sin(25.0 * CV_PI / 180.0);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const double z_mm = depth.at<float>(v, u) + camera.z_offset_mm;
+      const double x_mm = (u - camera.cx) / camera.fx * z_mm;
+      const double y_mm = (v - camera.cy) / camera.fy * z_mm;
+      if (x_mm * c + y_mm * s > 30.0) depth.at<float>(v, u) = far.at<float>(v, u);
+    }
+  }
+  const GroundDistance out = fit_plane(depth, chain_params());
+  ASSERT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_NEAR(out.distance_mm, near_level.distance_mm, 0.2);
+
+  json without_search = chain_params();
+  without_search["min_step_mm"] = 0;
+  const GroundDistance across = fit_plane(depth, without_search);
+  ASSERT_TRUE(across.valid) << across.invalid_reason;
+  EXPECT_GT(std::abs(across.distance_mm - near_level.distance_mm), 0.5);
 }
 
 // Residue covers the tool area (no soil within 50 mm of the tool point, five times

@@ -1,0 +1,244 @@
+#include "ground_steps.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+namespace tilth::estimation {
+namespace {
+
+// Lines every 180 / kAngles degrees, each also sheared by kShears strips per piece (up to
+// 8.5 deg, between the directions); the level is averaged in strips kStripMm wide along
+// them, and a side is kStripsPerSide strips.
+constexpr int kAngles = 12;
+constexpr double kShears[] = {-1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5};
+constexpr double kMaxShear = 1.5;
+constexpr double kStripMm = 4.0;
+constexpr int kStripsPerSide = 4;
+// A line is cut into pieces kPieceMm long; a step jumps in at least kMinPieces of them, each
+// side of each averaged over at least kMinSidePoints points.
+constexpr double kPieceMm = 40.0;
+constexpr std::size_t kMinPieces = 4;
+constexpr float kMinSidePoints = 8;
+// Either side of a step, the level varies by at most this fraction of its height.
+constexpr double kMaxUnevenness = 0.35;
+// A step jumps by at least this many times the median jump between neighbouring sides.
+constexpr double kRoughness = 3.0;
+// Levels this far off the surface are not ground (residue the segmentation let through).
+constexpr double kLevelBandMm = 16.0;
+
+// The jump every piece of a line shows, in all but one of them when there are four or
+// more; 0 when they do not agree on its sign.
+double weakest_jump(const std::vector<double>& jumps) {
+  // The two lowest and the two highest, in one pass.
+  double lowest = jumps[0], low = jumps[0], highest = jumps[0], high = jumps[0];
+  for (std::size_t i = 1; i < jumps.size(); ++i) {
+    const double jump = jumps[i];
+    if (i == 1) {
+      low = std::max(lowest, jump);
+      lowest = std::min(lowest, jump);
+      high = std::min(highest, jump);
+      highest = std::max(highest, jump);
+      continue;
+    }
+    if (jump < lowest) {
+      low = lowest;
+      lowest = jump;
+    } else if (jump < low) {
+      low = jump;
+    }
+    if (jump > highest) {
+      high = highest;
+      highest = jump;
+    } else if (jump > high) {
+      high = jump;
+    }
+  }
+  const bool spare_one = jumps.size() >= 4;
+  const double rising = spare_one ? low : lowest;
+  const double falling = spare_one ? high : highest;
+  return rising > 0 ? rising : falling < 0 ? falling : 0.0;
+}
+
+double median(std::vector<double>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// The levels along the lines of one direction: per piece, running sums over its strips,
+// so that a side of any line is two look-ups.
+class Strips {
+ public:
+  // Strips and pieces enough for points up to reach_mm from the tool point.
+  explicit Strips(double reach_mm)
+      : strips_(2 * static_cast<int>(std::ceil(reach_mm / kStripMm)) + 1),
+        pieces_(2 * static_cast<int>(std::ceil(reach_mm / kPieceMm)) + 1),
+        margin_(2 * kStripsPerSide + static_cast<int>(std::ceil(kMaxShear * (pieces_ / 2 + 1)))) {}
+
+  int strips() const { return strips_; }
+  int pieces() const { return pieces_; }
+
+  // The levels of `points` along lines in the direction (c, s): across them x c + y s.
+  void fill(std::span<const LevelPoint> points, double c, double s) {
+    sums_.assign(static_cast<std::size_t>(pieces_ * (strips_ + 1)), 0.0f);
+    counts_.assign(sums_.size(), 0.0f);
+    // Points next to each other fall in one strip: adding the list's two halves in turn
+    // keeps each sum from waiting for the one before.
+    const std::size_t half = points.size() / 2;
+    for (std::size_t i = 0; i < half; ++i) {
+      add(points[i], c, s);
+      add(points[half + i], c, s);
+    }
+    if (points.size() % 2 != 0) add(points.back(), c, s);
+    // Every side's mean, from running sums over the strips; NaN without enough points,
+    // and in the margins beyond the strips.
+    means_.assign(static_cast<std::size_t>(pieces_ * row()), kNoSide);
+    for (int piece = 0; piece < pieces_; ++piece) {
+      for (int strip = 1; strip <= strips_; ++strip) {
+        sums_[at(piece, strip)] += sums_[at(piece, strip - 1)];
+        counts_[at(piece, strip)] += counts_[at(piece, strip - 1)];
+      }
+      float* const means = writable_sides(piece);
+      for (int first = 0; first + kStripsPerSide <= strips_; ++first) {
+        const float count = counts_[at(piece, first + kStripsPerSide)] - counts_[at(piece, first)];
+        if (count < kMinSidePoints) continue;
+        means[first] = (sums_[at(piece, first + kStripsPerSide)] - sums_[at(piece, first)]) / count;
+      }
+    }
+  }
+
+  // The mean levels of the sides of `piece` by their first strip: NaN without enough
+  // points; readable from -margin() to strips() + margin().
+  const float* sides(int piece) const {
+    return means_.data() + static_cast<std::ptrdiff_t>(piece * row() + margin_);
+  }
+
+ private:
+  void add(const LevelPoint& point, double c, double s) {
+    // Shifted to be positive, so that truncation is floor.
+    const double across = (point.x_mm * c + point.y_mm * s) / kStripMm + strips_ / 2 + 1;
+    const double along = (point.y_mm * c - point.x_mm * s) / kPieceMm + pieces_ / 2;
+    const int strip = static_cast<int>(across);  // 1-based: running sums start at 0
+    const int piece = static_cast<int>(along);
+    if (across < 1 || strip > strips_ || along < 0 || piece >= pieces_) return;
+    sums_[at(piece, strip)] += static_cast<float>(point.level_mm);
+    counts_[at(piece, strip)] += 1.0f;
+  }
+
+  float* writable_sides(int piece) {
+    return means_.data() + static_cast<std::ptrdiff_t>(piece * row() + margin_);
+  }
+  int row() const { return strips_ + 1 + 2 * margin_; }
+
+  std::size_t at(int piece, int boundary) const {
+    return static_cast<std::size_t>(piece * (strips_ + 1) + boundary);
+  }
+
+  int strips_;
+  int pieces_;
+  int margin_;  // strips beyond either end that the sides of sheared lines reach
+  static constexpr float kNoSide = std::numeric_limits<float>::quiet_NaN();
+
+  // In float: four lanes a vector where the lines are counted.
+  std::vector<float> sums_, counts_, means_;
+};
+
+}  // namespace
+
+std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, double min_height_mm) {
+  thread_local std::vector<LevelPoint> ground;
+  thread_local std::vector<double> jumps, unevenness, differences;
+  thread_local std::vector<const float*> rows;                         // per piece
+  thread_local std::vector<int> counted, short_rising, short_falling;  // per line
+  ground.clear();
+  double reach = 0.0;
+  for (const LevelPoint& point : points) {
+    if (std::abs(point.level_mm) > kLevelBandMm) continue;
+    ground.push_back(point);
+    reach = std::max(reach, std::hypot(point.x_mm, point.y_mm));
+  }
+  Strips levels(reach);
+  const int strips = levels.strips(), pieces = levels.pieces();
+  std::optional<GroundStep> highest;
+  for (int angle = 0; angle < kAngles; ++angle) {
+    const double radians = std::numbers::pi * angle / kAngles;
+    const double c = std::cos(radians), s = std::sin(radians);
+    levels.fill(ground, c, s);
+    // How much the level of the ground varies from side to side of any line this way: on
+    // rough ground a step must stand out of its roughness.
+    differences.clear();
+    for (int edge = 0; edge <= strips; edge += kStripsPerSide) {
+      for (int piece = 0; piece < pieces; ++piece) {
+        const float* sides = levels.sides(piece);
+        const double jump = sides[edge] - sides[edge - kStripsPerSide];
+        if (!std::isnan(jump)) differences.push_back(std::abs(jump));
+      }
+    }
+    if (differences.empty()) continue;
+    const double least_height = std::max(min_height_mm, kRoughness * median(differences));
+    const auto least = static_cast<float>(least_height);
+    const auto edges = static_cast<std::size_t>(strips + 1);
+    for (const double shear : kShears) {
+      // Each piece's sides, shifted by where the line crosses it: this many strips from
+      // where it crosses the middle piece.
+      rows.clear();
+      for (int piece = 0; piece < pieces; ++piece) {
+        rows.push_back(levels.sides(piece) + std::lround(shear * (piece - pieces / 2 + 0.5)));
+      }
+      // Per line: its pieces, and those short of least_height rising and falling. A step
+      // rises (or falls) by least_height in all pieces but one.
+      counted.assign(edges, 0);
+      short_rising.assign(edges, 0);
+      short_falling.assign(edges, 0);
+      for (const float* sides : rows) {
+        for (std::size_t edge = 0; edge < edges; ++edge) {
+          const float jump =
+              sides[edge] - sides[static_cast<std::ptrdiff_t>(edge) - kStripsPerSide];
+          const int has = jump == jump;  // NaN: a side without enough points
+          counted[edge] += has;
+          short_rising[edge] += has & (jump < least);
+          short_falling[edge] += has & (jump > -least);
+        }
+      }
+      for (std::size_t edge = 0; edge < edges; ++edge) {
+        const int spared = counted[edge] >= 4 ? 1 : 0;
+        if (counted[edge] < static_cast<int>(kMinPieces) ||
+            (short_rising[edge] > spared && short_falling[edge] > spared)) {
+          continue;
+        }
+        const auto at = static_cast<std::ptrdiff_t>(edge);
+        jumps.clear();
+        for (const float* sides : rows) {
+          const double jump = sides[at] - sides[at - kStripsPerSide];
+          if (!std::isnan(jump)) jumps.push_back(jump);
+        }
+        const double height = weakest_jump(jumps);
+        if (std::abs(height) < least_height) continue;
+        if (highest && std::abs(height) <= std::abs(highest->height_mm)) continue;
+        // A step is flat on both sides; a wave of the relief across the line is not.
+        unevenness.clear();
+        for (const float* sides : rows) {
+          const double far_before =
+              std::abs(sides[at - kStripsPerSide] - sides[at - 2 * kStripsPerSide]);
+          const double far_beyond = std::abs(sides[at] - sides[at + kStripsPerSide]);
+          if (!std::isnan(far_before)) unevenness.push_back(far_before);
+          if (!std::isnan(far_beyond)) unevenness.push_back(far_beyond);
+        }
+        if (unevenness.empty() || median(unevenness) > kMaxUnevenness * std::abs(height)) continue;
+        // Across the line less `slope` times along it is constant: in (x, y), a line whose
+        // normal is turned from (c, s) by atan(slope).
+        const double slope = shear * kStripMm / kPieceMm;
+        const double norm = std::hypot(1.0, slope);
+        highest = GroundStep{(c + slope * s) / norm, (s - slope * c) / norm,
+                             (static_cast<int>(edge) - strips / 2) * kStripMm / norm, height};
+      }
+    }
+  }
+  return highest;
+}
+
+}  // namespace tilth::estimation
