@@ -150,6 +150,27 @@ TEST(GroundPlane, OnFlatSoilAgreesWithTheMedian) {
   EXPECT_EQ(plane.soil_pixels, median.soil_pixels);
 }
 
+// `near_level` where `beyond(x, y)` is false, the ground step_mm farther (its noise seeded
+// apart) where it is true; x, y in mm across the ground in the ToF camera frame.
+template <class Beyond>
+cv::Mat stepped_ground(const GroundScene& near_level, double step_mm, const Beyond& beyond) {
+  GroundScene far_level = near_level;
+  far_level.distance_mm += step_mm;
+  far_level.seed = near_level.seed + 1;
+  const DepthCameraCalibration& camera = paper_camera();
+  cv::Mat depth = testing::render(near_level, camera);
+  const cv::Mat far = testing::render(far_level, camera);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const double z_mm = depth.at<float>(v, u) + camera.z_offset_mm;
+      const double x_mm = (u - camera.cx) / camera.fx * z_mm;
+      const double y_mm = (v - camera.cy) / camera.fy * z_mm;
+      if (beyond(x_mm, y_mm)) depth.at<float>(v, u) = far.at<float>(v, u);
+    }
+  }
+  return depth;
+}
+
 // The ground steps 6 mm farther 15 mm to the right of the tool point, and the far level
 // holds most of the region. With the chain's settings the fit stays on the tool's level:
 // within 0.3 mm of it (its ~900 points near the tool, 1 mm noise: a standard error under
@@ -159,19 +180,7 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
   GroundScene near_level;
   near_level.tilt_x_deg = 2.0;
   near_level.noise_mm = 1.0;
-  GroundScene far_level = near_level;
-  far_level.distance_mm += 6.0;
-  far_level.seed = 2;
-  const DepthCameraCalibration& camera = paper_camera();
-  cv::Mat depth = testing::render(near_level, camera);
-  const cv::Mat far = testing::render(far_level, camera);
-  for (int v = 0; v < depth.rows; ++v) {
-    for (int u = 0; u < depth.cols; ++u) {
-      const double x_mm =
-          (u - camera.cx) / camera.fx * (depth.at<float>(v, u) + camera.z_offset_mm);
-      if (x_mm > 15.0) depth.at<float>(v, u) = far.at<float>(v, u);
-    }
-  }
+  const cv::Mat depth = stepped_ground(near_level, 6.0, [](double x, double) { return x > 15.0; });
   const GroundDistance out = fit_plane(depth, chain_params());
   ASSERT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(out.distance_mm, near_level.distance_mm, 0.3);
@@ -182,7 +191,7 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
   beside_the_step["tool_point"] = {40.0, 0.0};
   const GroundDistance beyond = fit_plane(depth, beside_the_step);
   ASSERT_TRUE(beyond.valid) << beyond.invalid_reason;
-  EXPECT_NEAR(beyond.distance_mm, testing::plane_distance_at(far_level, 40.0, 0.0), 0.3);
+  EXPECT_NEAR(beyond.distance_mm, testing::plane_distance_at(near_level, 40.0, 0.0) + 6.0, 0.3);
 }
 
 // A 4 mm step crosses the ground 30 mm from the tool point, turned 25 deg from the image's
@@ -194,21 +203,9 @@ TEST(GroundPlane, StandsOnTheToolsLevelNextToAStep) {
 TEST(GroundPlane, WideFitKeepsToTheToolsSideOfAStep) {
   GroundScene near_level;
   near_level.noise_mm = 1.0;
-  GroundScene far_level = near_level;
-  far_level.distance_mm += 4.0;
-  far_level.seed = 2;
-  const DepthCameraCalibration& camera = paper_camera();
-  cv::Mat depth = testing::render(near_level, camera);
-  const cv::Mat far = testing::render(far_level, camera);
   const double c = std::cos(25.0 * CV_PI / 180.0), s = std::sin(25.0 * CV_PI / 180.0);
-  for (int v = 0; v < depth.rows; ++v) {
-    for (int u = 0; u < depth.cols; ++u) {
-      const double z_mm = depth.at<float>(v, u) + camera.z_offset_mm;
-      const double x_mm = (u - camera.cx) / camera.fx * z_mm;
-      const double y_mm = (v - camera.cy) / camera.fy * z_mm;
-      if (x_mm * c + y_mm * s > 30.0) depth.at<float>(v, u) = far.at<float>(v, u);
-    }
-  }
+  const cv::Mat depth =
+      stepped_ground(near_level, 4.0, [&](double x, double y) { return x * c + y * s > 30.0; });
   const GroundDistance out = fit_plane(depth, chain_params());
   ASSERT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(out.distance_mm, near_level.distance_mm, 0.2);
