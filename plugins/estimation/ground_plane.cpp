@@ -531,7 +531,7 @@ StageDescriptor describe_ground_plane() {
           .describe("below this fraction of the soil points (weighed by their votes) on the "
                     "tool's surface the measurement is invalid"),
       ParamSpec::number("min_step_mm", 0.0)
-          .range(0, 100)
+          .range(0, 16)
           .in_unit("mm")
           .describe("the level jumping by this much along a straight line across the ground "
                     "is a step: the fit keeps to the tool's side of it; 0 = no search"),

@@ -147,6 +147,21 @@ class Strips {
   std::vector<float> sums_, counts_, means_;
 };
 
+// Whether the tool point lies beyond the line at strip boundary `at` of the pieces' sides
+// `rows`, at_mm from it: by where it lies, or for a line through it (within a strip), by
+// which side's level is nearer the surface fitted there (the levels are its residuals).
+bool tool_beyond(const std::vector<const float*>& rows, std::ptrdiff_t at, double at_mm) {
+  if (std::abs(at_mm) >= kStripMm) return at_mm < 0;
+  double before = 0, beyond = 0;
+  for (const float* sides : rows) {
+    const float jump = sides[at] - sides[at - kStripsPerSide];
+    if (std::isnan(jump)) continue;
+    before += sides[at - kStripsPerSide];
+    beyond += sides[at];
+  }
+  return std::abs(beyond) < std::abs(before);
+}
+
 }  // namespace
 
 std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, double min_height_mm) {
@@ -157,7 +172,10 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
   ground.clear();
   double reach = 0.0;
   for (const LevelPoint& point : points) {
-    if (std::abs(point.level_mm) > kLevelBandMm) continue;
+    if (!(std::abs(point.level_mm) <= kLevelBandMm) || !std::isfinite(point.x_mm) ||
+        !std::isfinite(point.y_mm)) {
+      continue;  // not ground, or no point at all
+    }
     ground.push_back(point);
     reach = std::max(reach, std::hypot(point.x_mm, point.y_mm));
   }
@@ -233,8 +251,9 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
         // normal is turned from (c, s) by atan(slope).
         const double slope = shear * kStripMm / kPieceMm;
         const double norm = std::hypot(1.0, slope);
-        highest = GroundStep{(c + slope * s) / norm, (s - slope * c) / norm,
-                             (static_cast<int>(edge) - strips / 2) * kStripMm / norm, height};
+        const double at_mm = (static_cast<int>(edge) - strips / 2) * kStripMm / norm;
+        highest = GroundStep{(c + slope * s) / norm, (s - slope * c) / norm, at_mm, height,
+                             tool_beyond(rows, at, at_mm)};
       }
     }
   }

@@ -7,6 +7,7 @@
 // segmentation's 3x3 median). A side of a piece of a line averages some 30 of them, so a
 // piece's jump has a standard error of 0.15 mm.
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -22,6 +23,8 @@ namespace {
 constexpr double kReachMm = 200.0;
 constexpr double kSpacingMm = 4.6;
 constexpr double kNoiseMm = 0.6;
+// A line's place is known to a strip.
+constexpr double kStripToleranceMm = 4.0;
 
 template <class Level>
 std::vector<LevelPoint> ground(const Level& level, int seed = 1) {
@@ -116,13 +119,45 @@ TEST(GroundSteps, StepsLowerThanAskedAreNotFound) {
   EXPECT_NEAR(lower->height_mm, 1.5, 0.4);
 }
 
-// A ridge 20 mm high every 600 mm (the `ridges` preset) curves, but jumps nowhere.
+// A step through the tool point: the levels are residuals from a surface fitted on the
+// tool's level, so the side whose level is near 0 is the tool's, and it is kept, on
+// whichever side of the line the tool point's own strip falls.
+TEST(GroundSteps, AStepThroughTheToolPointKeepsTheToolsLevel) {
+  for (const double at_mm : {-1.0, 1.0}) {
+    for (const double far_mm : {-3.0, 3.0}) {
+      const auto points = ground([&](double x, double) { return x > at_mm ? 0.0 : far_mm; });
+      const std::optional<GroundStep> step = highest_step(points, 2.0);
+      ASSERT_TRUE(step) << at_mm << ", " << far_mm;
+      EXPECT_TRUE(step->cuts_off(-20.0, 0.0)) << at_mm << ", " << far_mm;
+      EXPECT_FALSE(step->cuts_off(20.0, 0.0)) << at_mm << ", " << far_mm;
+    }
+  }
+}
+
+// Points without a level (NaN) or a place are left out, not summed into the strips.
+TEST(GroundSteps, PointsWithoutALevelOrPlaceAreLeftOut) {
+  auto points = ground([](double x, double) { return x > 30 ? 3.0 : 0.0; });
+  const std::optional<GroundStep> clean = highest_step(points, 2.0);
+  ASSERT_TRUE(clean);
+  for (std::size_t i = 0; i < points.size(); i += 7) points[i].level_mm = std::nan("");
+  points.push_back({std::nan(""), 0.0, 0.0});
+  points.push_back({std::numeric_limits<double>::infinity(), 0.0, 0.0});
+  const std::optional<GroundStep> step = highest_step(points, 2.0);
+  ASSERT_TRUE(step);
+  EXPECT_NEAR(step->at_mm, clean->at_mm, kStripToleranceMm);
+  EXPECT_NEAR(step->height_mm, clean->height_mm, 0.3);
+  EXPECT_FALSE(highest_step(std::vector<LevelPoint>{}, 2.0));
+}
+
+// A ridge 20 mm high every 600 mm (the `ridges` preset) curves, but jumps nowhere: not
+// even by 1 mm, whose line the ridge's flank (1.7 mm between neighbouring sides) would
+// pass but for the flat sides a step needs.
 TEST(GroundSteps, RidgesAreNoStep) {
   const auto points = ground([](double x, double y) {
     return 10.0 *
            std::sin(2 * CV_PI * (x * std::cos(radians(70)) + y * std::sin(radians(70))) / 600.0);
   });
-  EXPECT_FALSE(highest_step(points, 2.0));
+  EXPECT_FALSE(highest_step(points, 1.0));
 }
 
 }  // namespace
