@@ -179,7 +179,8 @@ void follow_relief(const cv::Mat& supported, double height_mm, double surface_px
       const auto* s = surface.ptr<float>(row);
       auto* out = soil.ptr<float>(row);
       for (int col = 0; col < supported.cols; ++col) {
-        const float is_soil = d[col] > 0 && s[col] - d[col] < below ? 1.0f : 0.0f;  // NaN: 0
+        // `&`, not `&&`: no branch, so that the loop vectorises. NaN: not soil.
+        const float is_soil = static_cast<float>((d[col] > 0) & (s[col] - d[col] < below));
         out[2 * col] = is_soil * d[col];
         out[2 * col + 1] = is_soil;
       }
@@ -223,7 +224,7 @@ void heights_above(const cv::Mat& half, const cv::Mat& depth, const cv::Mat& mis
     const auto* none = missing.ptr<std::uint8_t>(row);
     auto* out = height.ptr<float>(row);
     for (int col = 0; col < depth.cols; ++col) {
-      out[col] = none[col] == 0 && d[col] > 0 ? surface[col] - d[col] : kNaN;
+      out[col] = (none[col] == 0) & (d[col] > 0) ? surface[col] - d[col] : kNaN;
     }
   }
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 
@@ -57,11 +58,15 @@ float index_of(float b, float g, float r) {
   return 60 * ((r - g) / delta + 4);
 }
 
-// Writes each pixel's index and counts the trusted ones into the histogram.
+// Writes each pixel's index and counts the trusted ones into the histogram. Neighbouring
+// pixels often fall in one bin: counting them in turn into four histograms keeps each
+// count from waiting for the one before.
 template <ColorIndex kIndex>
 void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const IndexInfo& range,
                          cv::Mat& index, std::array<double, kBins>& histogram) {
+  constexpr int kLanes = 4;
   const float bins_per_unit = kBins / (range.high - range.low);
+  std::array<std::array<std::uint32_t, kBins>, kLanes> counts{};
   for (int row = 0; row < summed.rows; ++row) {
     const auto* in = summed.ptr<cv::Vec3w>(row);
     const auto* skip = untrusted.ptr<std::uint8_t>(row);
@@ -73,8 +78,11 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
       const float value = out[col];
       if (skip[col] != 0 || std::isnan(value)) continue;
       const int bin = static_cast<int>((value - range.low) * bins_per_unit);
-      ++histogram[std::clamp(bin, 0, kBins - 1)];
+      ++counts[col % kLanes][std::clamp(bin, 0, kBins - 1)];
     }
+  }
+  for (const auto& lane : counts) {
+    for (int bin = 0; bin < kBins; ++bin) histogram[bin] += lane[bin];
   }
 }
 
