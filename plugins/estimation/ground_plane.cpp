@@ -52,6 +52,7 @@
 #include "tilth/messages/ground_distance.h"
 #include "tilth/messages/registered_color.h"
 #include "tilth/plugin.h"
+#include "upper_median.h"
 
 namespace tilth::estimation {
 namespace {
@@ -178,12 +179,6 @@ class Quadric {
   Vector coefficients_;
 };
 
-double median(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 // The medians of the slopes of the triangles (p, p + kSlopeSpan to the right, p +
 // kSlopeSpan down) of soil grid points; nullopt without enough of them.
 std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t columns) {
@@ -207,7 +202,7 @@ std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t 
     }
   }
   if (dz_dx.size() < 3) return std::nullopt;
-  return Tilt{median(dz_dx), median(dz_dy)};
+  return Tilt{upper_median(dz_dx), upper_median(dz_dy)};
 }
 
 // The level (depth with the tilt taken out) the tool stands on: from the median of the

@@ -7,6 +7,8 @@
 #include <numbers>
 #include <vector>
 
+#include "upper_median.h"
+
 namespace tilth::estimation {
 namespace {
 
@@ -30,8 +32,8 @@ constexpr double kRoughness = 3.0;
 // Levels this far off the surface are not ground (residue the segmentation let through).
 constexpr double kLevelBandMm = 16.0;
 
-// The jump every piece of a line shows, in all but one of them when there are four or
-// more; 0 when they do not agree on its sign.
+// The jump every piece of a line shows but one (there are four or more); 0 when they do
+// not agree on its sign.
 double weakest_jump(const std::vector<double>& jumps) {
   // The two lowest and the two highest, in one pass.
   double lowest = jumps[0], low = jumps[0], highest = jumps[0], high = jumps[0];
@@ -57,16 +59,7 @@ double weakest_jump(const std::vector<double>& jumps) {
       high = jump;
     }
   }
-  const bool spare_one = jumps.size() >= 4;
-  const double rising = spare_one ? low : lowest;
-  const double falling = spare_one ? high : highest;
-  return rising > 0 ? rising : falling < 0 ? falling : 0.0;
-}
-
-double median(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
+  return low > 0 ? low : high < 0 ? high : 0.0;
 }
 
 // The levels along the lines of one direction: per piece, running sums over its strips,
@@ -74,10 +67,11 @@ double median(std::vector<double>& values) {
 class Strips {
  public:
   // Strips and pieces enough for points up to reach_mm from the tool point.
-  explicit Strips(double reach_mm)
-      : strips_(2 * static_cast<int>(std::ceil(reach_mm / kStripMm)) + 1),
-        pieces_(2 * static_cast<int>(std::ceil(reach_mm / kPieceMm)) + 1),
-        margin_(2 * kStripsPerSide + static_cast<int>(std::ceil(kMaxShear * (pieces_ / 2 + 1)))) {}
+  void reach(double reach_mm) {
+    strips_ = 2 * static_cast<int>(std::ceil(reach_mm / kStripMm)) + 1;
+    pieces_ = 2 * static_cast<int>(std::ceil(reach_mm / kPieceMm)) + 1;
+    margin_ = 2 * kStripsPerSide + static_cast<int>(std::ceil(kMaxShear * (pieces_ / 2 + 1)));
+  }
 
   int strips() const { return strips_; }
   int pieces() const { return pieces_; }
@@ -138,9 +132,9 @@ class Strips {
     return static_cast<std::size_t>(piece * (strips_ + 1) + boundary);
   }
 
-  int strips_;
-  int pieces_;
-  int margin_;  // strips beyond either end that the sides of sheared lines reach
+  int strips_ = 0;
+  int pieces_ = 0;
+  int margin_ = 0;  // strips beyond either end that the sides of sheared lines reach
   static constexpr float kNoSide = std::numeric_limits<float>::quiet_NaN();
 
   // In float: four lanes a vector where the lines are counted.
@@ -179,7 +173,8 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
     ground.push_back(point);
     reach = std::max(reach, std::hypot(point.x_mm, point.y_mm));
   }
-  Strips levels(reach);
+  thread_local Strips levels;  // its buffers kept from one frame to the next
+  levels.reach(reach);
   const int strips = levels.strips(), pieces = levels.pieces();
   std::optional<GroundStep> highest;
   for (int angle = 0; angle < kAngles; ++angle) {
@@ -197,7 +192,7 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
       }
     }
     if (differences.empty()) continue;
-    const double least_height = std::max(min_height_mm, kRoughness * median(differences));
+    const double least_height = std::max(min_height_mm, kRoughness * upper_median(differences));
     const auto least = static_cast<float>(least_height);
     const auto edges = static_cast<std::size_t>(strips + 1);
     for (const double shear : kShears) {
@@ -223,9 +218,8 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
         }
       }
       for (std::size_t edge = 0; edge < edges; ++edge) {
-        const int spared = counted[edge] >= 4 ? 1 : 0;
         if (counted[edge] < static_cast<int>(kMinPieces) ||
-            (short_rising[edge] > spared && short_falling[edge] > spared)) {
+            (short_rising[edge] > 1 && short_falling[edge] > 1)) {  // one piece is spared
           continue;
         }
         const auto at = static_cast<std::ptrdiff_t>(edge);
@@ -246,7 +240,8 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
           if (!std::isnan(far_before)) unevenness.push_back(far_before);
           if (!std::isnan(far_beyond)) unevenness.push_back(far_beyond);
         }
-        if (unevenness.empty() || median(unevenness) > kMaxUnevenness * std::abs(height)) continue;
+        if (unevenness.empty() || upper_median(unevenness) > kMaxUnevenness * std::abs(height))
+          continue;
         // Across the line less `slope` times along it is constant: in (x, y), a line whose
         // normal is turned from (c, s) by atan(slope).
         const double slope = shear * kStripMm / kPieceMm;

@@ -20,7 +20,8 @@ std::string size_text(const cv::Mat& image) {
 // Sets what lies outside `area` (the rows above and below it, the columns either side).
 void fill_outside(cv::Mat& image, const cv::Rect& area, double value) {
   for (const cv::Rect& band :
-       {cv::Rect(0, 0, image.cols, area.y), cv::Rect(0, area.br().y, image.cols, image.rows - area.br().y),
+       {cv::Rect(0, 0, image.cols, area.y),
+        cv::Rect(0, area.br().y, image.cols, image.rows - area.br().y),
         cv::Rect(0, area.y, area.x, area.height),
         cv::Rect(area.br().x, area.y, image.cols - area.br().x, area.height)}) {
     if (!band.empty()) image(band).setTo(value);
