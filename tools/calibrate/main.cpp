@@ -25,6 +25,7 @@
 #include "check_report.h"
 #include "color_window/region_window.h"
 #include "command_line.h"
+#include "command_usage.h"
 #include "commands.h"
 #include "framework/nearest_names.h"
 #include "number_pair.h"
@@ -555,6 +556,12 @@ int color_window(const CommandLine& line) {
   return kExitOk;
 }
 
+// `tilth calibrate COMMAND --help`: that command's part of the usage; the whole without one.
+std::string usage_of(const CommandLine& line) {
+  if (line.positional().empty()) return kUsage;
+  return tilth::cli::command_usage(kUsage, line.positional()[0]).value_or(kUsage);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -567,7 +574,7 @@ int main(int argc, char** argv) {
   }
   const CommandLine& line = *parsed;
   if (line.flag("--help")) {
-    std::cout << kUsage;
+    std::cout << usage_of(line);
     return kExitOk;
   }
   if (line.positional().empty()) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "command_line.h"
+#include "command_usage.h"
 #include "commands.h"
 #include "conversion.h"
 #include "data_loss_report.h"
@@ -231,6 +232,12 @@ bool has_mask_options(const CommandLine& line) {
          !line.values("--soil").empty();
 }
 
+// `tilth recording COMMAND --help`: that command's part of the usage; the whole without one.
+std::string usage_of(const CommandLine& line) {
+  if (line.positional().empty()) return kUsage;
+  return tilth::cli::command_usage(kUsage, line.positional()[0]).value_or(kUsage);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -246,7 +253,7 @@ int main(int argc, char** argv) {
   const CommandLine& line = *parsed;
   try {
     if (line.flag("--help")) {
-      std::cout << kUsage;
+      std::cout << usage_of(line);
       return kExitOk;
     }
     if (line.positional().empty()) return usage_error("expected a command");
