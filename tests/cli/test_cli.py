@@ -44,6 +44,16 @@ class HelpAndInspection(unittest.TestCase):
         help_ = tilth("help", "validate")
         self.assertEqual(help_.returncode, 0, help_.stderr)
         self.assertEqual(help_.stdout, tilth("validate", "--help").stdout)
+        # A command of a group: its own part of the group's usage, by either spelling.
+        info = tilth("help", "recording", "info")
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertEqual(info.stdout, tilth("recording", "info", "-h").stdout)
+        self.assertRegex(info.stdout, r"^usage: tilth recording\n\n  info FILE ")
+        self.assertNotIn("repair", info.stdout)
+        window = tilth("calibrate", "color-window", "--help").stdout
+        self.assertIn("  color-window RIG.calib.json --distance-mm NEAR:FAR\n", window)
+        self.assertNotIn("  solve ", window)
+        self.assertEqual(tilth("help", "recording").stdout, tilth("recording", "--help").stdout)
         wrong = tilth("valdate", "g.json")
         self.assertEqual(wrong.returncode, 2)
         self.assertIn("tilth: unknown command 'valdate'; did you mean 'validate'?", wrong.stderr)

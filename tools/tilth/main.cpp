@@ -25,7 +25,8 @@ commands:
   plugins          list the stage types of the plugins found, with their ports
   describe TYPE    print a stage type's ports and full parameter schema
   dot GRAPH        print a graph as Graphviz dot
-  help COMMAND     describe a command's options (as 'tilth COMMAND --help')
+  help COMMAND     describe a command's options (as 'tilth COMMAND --help'); for the
+                   commands of a group, 'tilth help recording info' describes one
 
 'tilth --version' prints the release and what it was built with. Any other COMMAND runs the
 program tilth-COMMAND found next to tilth or on PATH.
@@ -62,12 +63,15 @@ int main(int argc, char** argv) {
     print_version();
     return kExitOk;
   }
-  // `tilth help COMMAND` is `tilth COMMAND --help`.
+  // `tilth help COMMAND [SUBCOMMAND]` is `tilth COMMAND [SUBCOMMAND] --help`.
   std::vector<char*> help_arguments;
   if (std::strcmp(argv[1], "help") == 0) {
     static char help_flag[] = "--help";
-    help_arguments = {argv[0], argv[2], help_flag, nullptr};
-    argc = 3;
+    help_arguments = {argv[0]};
+    help_arguments.insert(help_arguments.end(), argv + 2, argv + argc);
+    help_arguments.push_back(help_flag);
+    argc = static_cast<int>(help_arguments.size());
+    help_arguments.push_back(nullptr);
     argv = help_arguments.data();
   }
   const std::string command = argv[1];
