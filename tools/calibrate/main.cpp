@@ -556,12 +556,6 @@ int color_window(const CommandLine& line) {
   return kExitOk;
 }
 
-// `tilth calibrate COMMAND --help`: that command's part of the usage; the whole without one.
-std::string usage_of(const CommandLine& line) {
-  if (line.positional().empty()) return kUsage;
-  return tilth::cli::command_usage(kUsage, line.positional()[0]).value_or(kUsage);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -574,7 +568,7 @@ int main(int argc, char** argv) {
   }
   const CommandLine& line = *parsed;
   if (line.flag("--help")) {
-    std::cout << usage_of(line);
+    std::cout << tilth::cli::help_text(kUsage, line.positional());
     return kExitOk;
   }
   if (line.positional().empty()) {

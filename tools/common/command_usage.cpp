@@ -49,4 +49,9 @@ std::optional<std::string> command_usage(std::string_view usage, std::string_vie
   return std::nullopt;
 }
 
+std::string help_text(std::string_view usage, const std::vector<std::string>& positional) {
+  if (positional.empty()) return std::string(usage);
+  return command_usage(usage, positional[0]).value_or(std::string(usage));
+}
+
 }  // namespace tilth::cli

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace tilth::cli {
 
@@ -13,5 +14,9 @@ namespace tilth::cli {
 // "usage: tilth TOOL" followed by the command's lines, or nullopt for a command the text
 // does not list.
 std::optional<std::string> command_usage(std::string_view usage, std::string_view command);
+
+// What `tilth TOOL [COMMAND] --help` prints: the command's part of `usage` when the first
+// of `positional` names one, else the whole.
+std::string help_text(std::string_view usage, const std::vector<std::string>& positional);
 
 }  // namespace tilth::cli
