@@ -24,12 +24,13 @@ constexpr std::array<std::string_view, 7> kColumnNames{
     "mask",  "ground_truth_mm"};
 constexpr std::size_t kRequiredColumns = 5;  // index .. color; mask and ground truth optional
 
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> fields;
+// The comma-separated fields of `line` into `fields`, whose storage is reused line after line.
+void split(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
   for (;;) {
     const auto comma = line.find(',');
     fields.push_back(line.substr(0, comma));
-    if (comma == std::string_view::npos) return fields;
+    if (comma == std::string_view::npos) return;
     line.remove_prefix(comma + 1);
   }
 }
@@ -103,7 +104,8 @@ using ColumnPositions = std::array<std::optional<std::size_t>, kColumnNames.size
 ColumnPositions read_header(const fs::path& file, std::string_view header) {
   const LineReader reader(file, 1);
   ColumnPositions positions;
-  const auto names = split(header);
+  std::vector<std::string_view> names;
+  split(header, names);
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::size_t c = 0;
     while (c < kColumnNames.size() && kColumnNames[c] != names[i]) ++c;
@@ -144,7 +146,9 @@ std::vector<FrameEntry> read_frames_csv(const fs::path& file) {
   if (!lines.next(text))
     throw Error(file.string() + ":1: expected the header line, got an empty file");
   const ColumnPositions positions = read_header(file, text);
-  const std::size_t field_count = split(text).size();
+  std::vector<std::string_view> fields;
+  split(text, fields);
+  const std::size_t field_count = fields.size();
 
   std::vector<FrameEntry> entries;
   while (lines.next(text)) {
@@ -155,7 +159,7 @@ std::vector<FrameEntry> read_frames_csv(const fs::path& file) {
                   std::to_string(kMaxFrames) + " frames; expected at most that many");
     }
     const LineReader reader(file, line);
-    const auto fields = split(text);
+    split(text, fields);
     if (fields.size() != field_count) {
       reader.fail("expected " + std::to_string(field_count) + " fields as in the header, got " +
                   std::to_string(fields.size()));
@@ -218,6 +222,7 @@ void rewrite_mask_column(const fs::path& file, const std::map<std::size_t, std::
   rewritten.reserve(text.size() + 32 * masks.size());
   std::optional<std::size_t> mask_position;  // none: the column is added at the end
   std::size_t number = 0;
+  std::vector<std::string_view> fields;
   for (std::size_t start = 0; start < text.size();) {
     const std::size_t newline = text.find('\n', start);
     const std::size_t next = newline == std::string::npos ? text.size() : newline + 1;
@@ -228,7 +233,7 @@ void rewrite_mask_column(const fs::path& file, const std::map<std::size_t, std::
     std::string_view end = line;
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
     end.remove_prefix(line.size());
-    const auto fields = split(line);
+    split(line, fields);
     if (number == 1) {
       for (std::size_t i = 0; i < fields.size(); ++i) {
         if (fields[i] == kColumnNames[kMask]) mask_position = i;

@@ -634,7 +634,7 @@ TEST_F(ImageFolderSourceTest, FramesCsvBeyondItsLimitsIsALocatedError) {
   lines += "\n";
   for (int i = 0; i <= 1'000'000; ++i) {
     const std::string n = std::to_string(i);
-    lines += n + "," + n + "," + n + ",d,c,,\n";
+    lines.append(n).append(",").append(n).append(",").append(n).append(",d,c,,\n");
   }
   write_text(folder_ / "frames.csv", lines);
   EXPECT_EQ(start_failure(),
