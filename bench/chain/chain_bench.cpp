@@ -28,6 +28,7 @@
 #include "tilth/calibration.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_distance.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace {
 
@@ -83,11 +84,9 @@ StageRegistry& registry() {
 // A stage with its defaults, the shipped calibration where it takes one, and `params`.
 StageInstance make(const std::string& type, nlohmann::json params = nlohmann::json::object()) {
   const auto& descriptor = registry().find(type)->descriptor;
-  for (const auto& spec : descriptor.params) {
-    if (!params.contains(spec.name)) params[spec.name] = spec.default_value;
-  }
-  if (params.contains("calibration")) params["calibration"] = kCalibration;
-  return registry().create(type, StageContext{type, Params(params), Logger(type), {}});
+  if (descriptor.param("calibration") != nullptr) params["calibration"] = kCalibration;
+  return registry().create(
+      type, StageContext{type, testing::stage_params(descriptor, params), Logger(type), {}});
 }
 
 // The node `name` of the chain file as the graph loader reads it (variables substituted),

@@ -9,15 +9,19 @@
 #include "source_tree.h"
 #include "tilth/frame.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::depth {
 namespace {
 
 void BM_DepthProjection(benchmark::State& state) {
   const std::string calibration = testing::paper_rig_path().string();
-  const StageContext context{
-      "projection", Params(nlohmann::json{{"calibration", calibration}}), Logger("projection"), {}};
-  const std::unique_ptr<Stage> stage = describe_projection().create(context);
+  const StageDescriptor descriptor = describe_projection();
+  const StageContext context{"projection",
+                             testing::stage_params(descriptor, {{"calibration", calibration}}),
+                             Logger("projection"),
+                             {}};
+  const std::unique_ptr<Stage> stage = descriptor.create(context);
   auto& projection = dynamic_cast<Transform&>(*stage);
 
   // Soil at about 518 mm (gray 23666) with 1 mm of range noise (synthetic.tof_plane's

@@ -16,6 +16,7 @@
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::registration {
 namespace {
@@ -24,12 +25,9 @@ const std::string kCalibration = testing::paper_rig_path().string();
 
 // A stage with its defaults, the shipped calibration and `params`.
 std::unique_ptr<Stage> make(const StageDescriptor& descriptor, nlohmann::json params) {
-  for (const auto& spec : descriptor.params) {
-    if (!params.contains(spec.name)) params[spec.name] = spec.default_value;
-  }
   params["calibration"] = kCalibration;
-  return descriptor.create(
-      StageContext{descriptor.type, Params(params), Logger(descriptor.type), {}});
+  return descriptor.create(StageContext{
+      descriptor.type, testing::stage_params(descriptor, params), Logger(descriptor.type), {}});
 }
 
 std::shared_ptr<const Message> run(Stage& stage, std::span<const Packet> inputs) {

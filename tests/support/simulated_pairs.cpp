@@ -4,17 +4,17 @@
 
 #include "source_tree.h"
 #include "tilth/plugin.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth::testing {
 
 std::vector<SimulatedPair> render_pairs(StageRegistry& registry, const std::string& preset,
                                         int count) {
-  nlohmann::json params = {{"calibration", paper_rig_path().string()}, {"preset", preset}};
-  for (const auto& spec : registry.find("synthetic.scene")->descriptor.params) {
-    if (!params.contains(spec.name)) params[spec.name] = spec.default_value;
-  }
-  StageInstance scene = registry.create("synthetic.scene",
-                                        StageContext{"scene", Params(params), Logger("scene"), {}});
+  const Params params =
+      stage_params(registry.find("synthetic.scene")->descriptor,
+                   {{"calibration", paper_rig_path().string()}, {"preset", preset}});
+  StageInstance scene =
+      registry.create("synthetic.scene", StageContext{"scene", params, Logger("scene"), {}});
   std::vector<SimulatedPair> rendered;
   for (int i = 0; i < count; ++i) {
     std::vector<Packet> outputs(3);

@@ -13,6 +13,7 @@
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/messages/residue_mask.h"
+#include "tilth/testing/stage_harness.h"
 
 namespace tilth {
 namespace {
@@ -32,12 +33,12 @@ class SceneTest : public ::testing::Test {
 
   // Makes the stage with its defaults and these parameters, and produces `count` frames.
   std::vector<SceneFrame> frames(nlohmann::json params, int count) {
-    const auto& descriptor = registry_.find("synthetic.scene")->descriptor;
-    for (const auto& spec : descriptor.params) {
-      if (!params.contains(spec.name)) params[spec.name] = spec.default_value;
-    }
     params["calibration"] = kCalibration;
-    StageContext context{"scene", Params(params), Logger("scene"), {}};
+    StageContext context{
+        "scene",
+        tilth::testing::stage_params(registry_.find("synthetic.scene")->descriptor, params),
+        Logger("scene"),
+        {}};
     StageInstance instance = registry_.create("synthetic.scene", context);
     auto* source = dynamic_cast<Source*>(instance.stage.get());
     std::vector<SceneFrame> result;
