@@ -11,8 +11,8 @@
 // Colour: reflectance times sun and sky light (with shadows) plus sensor noise, optionally
 // as a Bayer mosaic. Static presets are rendered once and re-noised per frame; moving ground
 // is rendered per frame.
-#include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -27,6 +27,7 @@
 #include "tilth/messages/residue_mask.h"
 #include "tilth/playback_clock.h"
 #include "tilth/plugin.h"
+#include "tilth/replay_host_time.h"
 
 namespace tilth::synthetic {
 namespace {
@@ -85,6 +86,7 @@ class SceneSource final : public Source {
                                                      : preset_.frames),
         clock_(context.params.number("fps") > 0 ? 1.0 : 0.0),
         pace_ns_(context.params.number("fps") > 0 ? 1e9 / context.params.number("fps") : 0.0),
+        host_time_(context.params),
         noise_mm_at_500_(context.params.number("noise_mm")),
         dropout_(context.params.number("dropout")),
         color_noise_(context.params.number("color_noise")),
@@ -131,9 +133,11 @@ class SceneSource final : public Source {
     truth.distance_mm = soil_z_ - scene_->ground_height_mm(shift, 0.0) - rig_.depth.z_offset_mm;
     truth.residue_mask = truth_mask_.clone();
 
-    const auto host_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                             std::chrono::system_clock::now().time_since_epoch())
-                             .count();
+    // Simulated host times follow the device clock from the first frame's host time.
+    if (!host_clock_at_device_zero_ns_) {
+      host_clock_at_device_zero_ns_ = host_time_.stamp(std::nullopt) - device_ns;
+    }
+    const std::int64_t host_ns = host_time_.stamp(*host_clock_at_device_zero_ns_ + device_ns);
     frame.set_capture(static_cast<std::uint64_t>(index_), device_ns, host_ns);
     frame.emit(kRaw, std::move(raw));
     frame.emit(kColor, std::move(color));
@@ -288,6 +292,8 @@ class SceneSource final : public Source {
   const std::int64_t frames_;
   PlaybackClock clock_;
   const double pace_ns_;  // between frames, at the `fps` parameter
+  const ReplayHostTime host_time_;
+  std::optional<std::int64_t> host_clock_at_device_zero_ns_;
   const double noise_mm_at_500_;
   const double dropout_;
   const double color_noise_;
@@ -329,6 +335,10 @@ StageDescriptor describe() {
           .range(0, 1000)
           .in_unit("1/s")
           .describe("pace of the frames; 0 = as fast as they are made"),
+      ReplayHostTime::param(
+          "the simulated capture time: the first frame's host time plus the device "
+          "clock since (1/30 s a frame), so that stages that keep time (estimation.temporal) "
+          "see the cameras' pace however slowly the frames render"),
       ParamSpec::number("ground_distance_mm", 0.0)
           .range(0, 5000)
           .in_unit("mm")

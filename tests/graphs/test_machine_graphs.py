@@ -146,12 +146,13 @@ class MachineGraphs(unittest.TestCase):
                     ' "params": {"path": "%s"}}}, "edges": [["chain/estimate.distance",'
                     ' "measured.distance"]]}' % (os.path.join(GRAPHS, "simulated", "seeder.json"),
                                                  measured_csv))
-        # The simulator renders a moving ground at about a frame a second here, far slower
-        # than the cameras; the hold is lengthened to match (its timing has unit tests).
+        # The simulator renders a moving ground at about a frame a second here (over 10 s
+        # under ASan on a loaded machine), far slower than the cameras: its frames carry
+        # their simulated capture times, 1/30 s apart, as the seeder's hold would see them.
         done = subprocess.run(
             [TILTH, "run", graph, "--quiet", "--var", "log=" + served_csv,
              "--set", "camera.preset=steps", "--set", "camera.first_frame=72",
-             "--set", "camera.frames=14", "--set", "hold.max_hold_ms=10000",
+             "--set", "camera.frames=14", "--set", "camera.host_time=recorded",
              "--set", "runtime.when_full=block"], capture_output=True, text=True, timeout=300)
         self.assertEqual(done.returncode, 0, done.stderr)
         with open(measured_csv, newline="") as f:

@@ -1,6 +1,7 @@
 // The scene simulator against geometry computed independently: flat soil gives eq. 1's
 // inverse exactly before noise; the truth follows the soil layers of the moving
 // platform; frames are deterministic per seed; residue shows in the truth mask.
+#include <chrono>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -124,6 +125,30 @@ TEST_F(SceneTest, LayeredPlatformTruthFollowsTheLayers) {
     EXPECT_EQ(produced[0].info.frame_id, static_cast<std::uint64_t>(layer * 60 + 30));
     EXPECT_DOUBLE_EQ(*produced[0].truth.distance_mm, expected[layer]) << layer;
   }
+}
+
+// A frame's host time is when it was made (here paced at 10 frames/s), or with host_time
+// "recorded" the simulated capture time: the device clock (30 frames/s) from the first
+// frame's host time, as the cameras would have stamped it however slowly frames render.
+TEST_F(SceneTest, HostTimesAreWhenMadeOrTheSimulatedCaptureTimes) {
+  const auto now_ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+  };
+  const std::int64_t before_ns = now_ns();
+  const auto simulated = frames({{"preset", "case_a"}, {"fps", 10}, {"host_time", "recorded"}}, 3);
+  const std::int64_t after_ns = now_ns();
+  ASSERT_EQ(simulated.size(), 3u);
+  EXPECT_GE(simulated[0].info.host_timestamp_ns, before_ns);
+  EXPECT_LE(simulated[0].info.host_timestamp_ns, after_ns);
+  EXPECT_EQ(simulated[1].info.host_timestamp_ns - simulated[0].info.host_timestamp_ns, 33'333'333);
+  EXPECT_EQ(simulated[2].info.host_timestamp_ns - simulated[0].info.host_timestamp_ns, 66'666'666);
+
+  const auto made = frames({{"preset", "case_a"}, {"fps", 10}}, 2);
+  ASSERT_EQ(made.size(), 2u);
+  // 100 ms apart, give or take the difference of the two frames' noising.
+  EXPECT_GT(made[1].info.host_timestamp_ns - made[0].info.host_timestamp_ns, 50'000'000);
 }
 
 TEST_F(SceneTest, BayerMosaicKeepsOneChannelPerPixel) {
