@@ -13,9 +13,10 @@ trained on the masks and on labels from depth. Every segmenter is scored the sam
 its mask undilated and not despeckled (the decision itself), over the region the chain
 segments (`middle_half`), against the truth's soil and residue pixels, a pixel called
 unknown counting as not residue (sinks.evaluation). The table is residue IoU per
-recording, and pooled over all pixels. One column, classifier_field, is trained on the
-held-out recording's frames too, by their labels from depth (never its masks): a field's
-own unlabelled recordings, as `tilth train-segmenter --labels depth` is for.
+recording, and pooled over all pixels. Two columns, classifier_field and cnn_field, are
+trained on other passes over the same fields (each preset simulated again with
+--field-seed), by their labels from depth: a field's own unlabelled recordings, as
+`tilth train-segmenter --labels depth` is for. They never see the held-out recording.
 
     python3 tools/compare_segmenters.py --recordings /tmp/segmenters > table.md
 
@@ -45,20 +46,22 @@ RULES = [
      {"segment.type": "segmentation.self_trained", "segment.training": "inline"}),
 ]
 # name, what it is, train-segmenter options, the stage, its model file's extension, and
-# whether the held-out recording's frames join the training (by their depth labels only:
-# its masks are never trained on).
+# what it is trained on: the other recordings ("others") or the fields' other passes
+# ("field", by their depth labels; one model for every held-out recording).
 LEARNED = [
     ("classifier", "pixel classifier (texture, forest) trained on the masks", [],
-     "segmentation.pixel_classifier", ".yml.gz", False),
+     "segmentation.pixel_classifier", ".yml.gz", "others"),
     ("classifier_depth", "the same trained on labels from depth", ["--labels", "depth"],
-     "segmentation.pixel_classifier", ".yml.gz", False),
-    ("classifier_field", "the same trained on labels from depth with the held-out "
-     "recording's own frames: a field's unlabelled recordings", ["--labels", "depth"],
-     "segmentation.pixel_classifier", ".yml.gz", True),
+     "segmentation.pixel_classifier", ".yml.gz", "others"),
+    ("classifier_field", "the same trained on labels from depth of other passes over the "
+     "same fields: a field's unlabelled recordings", ["--labels", "depth"],
+     "segmentation.pixel_classifier", ".yml.gz", "field"),
     ("cnn", "the U-Net trained on the masks", ["--model", "cnn"], "segmentation.cnn", ".onnx",
-     False),
+     "others"),
     ("cnn_depth", "the same trained on labels from depth", ["--model", "cnn", "--labels", "depth"],
-     "segmentation.cnn", ".onnx", False),
+     "segmentation.cnn", ".onnx", "others"),
+    ("cnn_field", "the U-Net trained on labels from depth of other passes over the same "
+     "fields", ["--model", "cnn", "--labels", "depth"], "segmentation.cnn", ".onnx", "field"),
 ]
 # The same scoring for every segmenter.
 SCORED = {"segment.dilation_px": 0, "segment.speckle_px": 0, "segment.roi": "middle_half"}
@@ -72,20 +75,24 @@ def run(command, log):
         sys.exit("failed (%d): %s; see %s" % (result.returncode, " ".join(command), log.name))
 
 
-def simulate(tilth, folder, preset, args, log):
+def simulate(tilth, folder, preset, seed, args, log):
     path = os.path.join(folder, preset)
     if not os.path.isdir(path):
-        run([tilth, "simulate", path, "--preset", preset, "--seed", str(args.seed), "--frames",
+        run([tilth, "simulate", path, "--preset", preset, "--seed", str(seed), "--frames",
              str(args.frames)], log)
     return path
 
 
-def train(tilth, folder, held, recordings, learned, args, log):
-    name, _, options, _, extension, with_held = learned
-    model = os.path.join(folder, "models", "%s-%s-%s%s" % (
-        name, "with" if with_held else "without", os.path.basename(held), extension))
+def train(tilth, folder, held, recordings, passes, learned, args, log):
+    name, _, options, _, extension, trained_on = learned
+    if trained_on == "field":
+        model = os.path.join(folder, "models", "%s-seed%d%s" % (name, args.field_seed, extension))
+        trained = passes
+    else:
+        model = os.path.join(folder, "models", "%s-without-%s%s" % (
+            name, os.path.basename(held), extension))
+        trained = [r for r in recordings if r != held]
     if not os.path.exists(model):
-        trained = [r for r in recordings if with_held or r != held]
         command = [tilth, "train-segmenter", *trained, "--test", held, "--out", model, *options]
         if "cnn" in options:
             command += ["--epochs", str(args.cnn_epochs), "--steps", str(args.cnn_steps)]
@@ -121,22 +128,30 @@ def main():
     # Static presets re-noise one scene per frame: more frames add little.
     parser.add_argument("--frames", type=int, default=3)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--field-seed", type=int, default=2,
+                        help="the fields' other passes, which the _field models train on")
+    parser.add_argument("--only", nargs="+", help="these segmenters alone")
     parser.add_argument("--cnn-epochs", type=int, default=12)
     parser.add_argument("--cnn-steps", type=int, default=15)
     args = parser.parse_args()
     tilth = os.environ.get("TILTH", os.path.join(SOURCE, "build", "bin", "tilth"))
     folder = args.recordings or tempfile.mkdtemp(prefix="tilth-segmenters-")
     os.makedirs(os.path.join(folder, "models"), exist_ok=True)
-    names = [r[0] for r in RULES] + [l[0] for l in LEARNED]
+    rules = [r for r in RULES if not args.only or r[0] in args.only]
+    learned_ones = [l for l in LEARNED if not args.only or l[0] in args.only]
+    names = [r[0] for r in rules] + [l[0] for l in learned_ones]
     table = {}
     with open(os.path.join(folder, "log.txt"), "a") as log:
-        recordings = [simulate(tilth, folder, preset, args, log) for preset in args.presets]
+        recordings = [simulate(tilth, folder, preset, args.seed, args, log)
+                      for preset in args.presets]
+        passes = [simulate(tilth, os.path.join(folder, "seed%d" % args.field_seed), preset,
+                           args.field_seed, args, log) for preset in args.presets]
         for held in recordings:
             variants = []
-            for name, _, settings in RULES:
+            for name, _, settings in rules:
                 variants += variant_options(name, settings)
-            for learned in LEARNED:
-                model = train(tilth, folder, held, recordings, learned, args, log)
+            for learned in learned_ones:
+                model = train(tilth, folder, held, recordings, passes, learned, args, log)
                 variants += variant_options(learned[0], {"segment.type": learned[3],
                                                          "segment.model": model})
             out = os.path.join(folder, "ab", os.path.basename(held))
@@ -157,7 +172,7 @@ def main():
         print("| `%s` | %s |" % (recording, " | ".join(cells)))
     print("| all pixels | %s |" % " | ".join("**%.2f**" % iou(*pooled[n]) for n in names))
     print()
-    for name, what, *_ in RULES + LEARNED:
+    for name, what, *_ in rules + learned_ones:
         print("- `%s`: %s" % (name, what))
 
 
