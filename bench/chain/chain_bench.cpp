@@ -28,7 +28,7 @@
 #include "tilth/calibration.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/ground_distance.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace {
 
@@ -85,8 +85,8 @@ StageRegistry& registry() {
 StageInstance make(const std::string& type, nlohmann::json params = nlohmann::json::object()) {
   const auto& descriptor = registry().find(type)->descriptor;
   if (descriptor.param("calibration") != nullptr) params["calibration"] = kCalibration;
-  return registry().create(
-      type, StageContext{type, testing::stage_params(descriptor, params), Logger(type), {}});
+  return registry().create(type,
+                           StageContext{type, stage_params(descriptor, params), Logger(type), {}});
 }
 
 // The node `name` of the chain file as the graph loader reads it (variables substituted),

@@ -9,7 +9,7 @@
 #include "source_tree.h"
 #include "tilth/frame.h"
 #include "tilth/messages/raw_tof_frame.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::depth {
 namespace {
@@ -18,7 +18,7 @@ void BM_DepthProjection(benchmark::State& state) {
   const std::string calibration = testing::paper_rig_path().string();
   const StageDescriptor descriptor = describe_projection();
   const StageContext context{"projection",
-                             testing::stage_params(descriptor, {{"calibration", calibration}}),
+                             stage_params(descriptor, {{"calibration", calibration}}),
                              Logger("projection"),
                              {}};
   const std::unique_ptr<Stage> stage = descriptor.create(context);

@@ -16,7 +16,7 @@
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/depth_image.h"
 #include "tilth/messages/raw_tof_frame.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::registration {
 namespace {
@@ -26,8 +26,8 @@ const std::string kCalibration = testing::paper_rig_path().string();
 // A stage with its defaults, the shipped calibration and `params`.
 std::unique_ptr<Stage> make(const StageDescriptor& descriptor, nlohmann::json params) {
   params["calibration"] = kCalibration;
-  return descriptor.create(StageContext{
-      descriptor.type, testing::stage_params(descriptor, params), Logger(descriptor.type), {}});
+  return descriptor.create(
+      StageContext{descriptor.type, stage_params(descriptor, params), Logger(descriptor.type), {}});
 }
 
 std::shared_ptr<const Message> run(Stage& stage, std::span<const Packet> inputs) {

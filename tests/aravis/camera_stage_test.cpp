@@ -23,7 +23,7 @@
 #include "tilth/messages/camera_status.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/raw_tof_frame.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::aravis {
 namespace {
@@ -86,7 +86,7 @@ class CameraStage {
   CameraStage(const StageDescriptor& descriptor, const json& params) {
     StageContext context;
     context.node = "camera";
-    context.params = testing::stage_params(descriptor, params);
+    context.params = stage_params(descriptor, params);
     context.log = Logger(context.node);
     stage_ = descriptor.create(context);
     source_ = dynamic_cast<Source*>(stage_.get());

@@ -12,6 +12,7 @@
 #include "tilth/messages/camera_status.h"
 #include "tilth/messages/color_image.h"
 #include "tilth/messages/raw_tof_frame.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::pairing {
 namespace {
@@ -41,12 +42,12 @@ class PairingTest : public ::testing::Test {
  protected:
   void make(const nlohmann::json& params) {
     registry_.load(TILTH_PAIRING_PLUGIN);
-    nlohmann::json values = nlohmann::json::object();
-    for (const auto& spec : registry_.find("pairing.depth_color")->descriptor.params) {
-      values[spec.name] = params.contains(spec.name) ? params[spec.name] : spec.default_value;
-    }
     instance_ =
-        registry_.create("pairing.depth_color", {"pair", Params(values), Logger("pair"), {}});
+        registry_.create("pairing.depth_color",
+                         {"pair",
+                          stage_params(registry_.find("pairing.depth_color")->descriptor, params),
+                          Logger("pair"),
+                          {}});
     stage_ = dynamic_cast<Synchronizer*>(instance_.stage.get());
     ASSERT_NE(stage_, nullptr);
   }

@@ -4,7 +4,7 @@
 
 #include "source_tree.h"
 #include "tilth/plugin.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::testing {
 

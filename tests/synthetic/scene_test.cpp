@@ -14,7 +14,7 @@
 #include "tilth/messages/ground_truth.h"
 #include "tilth/messages/raw_tof_frame.h"
 #include "tilth/messages/residue_mask.h"
-#include "tilth/testing/stage_harness.h"
+#include "tilth/stage_params.h"
 
 namespace tilth {
 namespace {
@@ -35,11 +35,10 @@ class SceneTest : public ::testing::Test {
   // Makes the stage with its defaults and these parameters, and produces `count` frames.
   std::vector<SceneFrame> frames(nlohmann::json params, int count) {
     params["calibration"] = kCalibration;
-    StageContext context{
-        "scene",
-        tilth::testing::stage_params(registry_.find("synthetic.scene")->descriptor, params),
-        Logger("scene"),
-        {}};
+    StageContext context{"scene",
+                         stage_params(registry_.find("synthetic.scene")->descriptor, params),
+                         Logger("scene"),
+                         {}};
     StageInstance instance = registry_.create("synthetic.scene", context);
     auto* source = dynamic_cast<Source*>(instance.stage.get());
     std::vector<SceneFrame> result;

@@ -15,25 +15,9 @@
 #include "tilth/error.h"
 #include "tilth/frame.h"
 #include "tilth/stage_descriptor.h"
+#include "tilth/stage_params.h"
 
 namespace tilth::testing {
-
-// Every declared parameter, its default unless `overrides` sets it. Throws tilth::Error
-// for an undeclared or ill-typed override, as the graph loader reports one.
-inline Params stage_params(const StageDescriptor& descriptor, const nlohmann::json& overrides) {
-  nlohmann::json values = nlohmann::json::object();
-  for (const auto& spec : descriptor.params) values[spec.name] = spec.default_value;
-  for (const auto& [name, value] : overrides.items()) {
-    const ParamSpec* spec = descriptor.param(name);
-    if (spec == nullptr) throw Error(descriptor.type + ": no parameter '" + name + "'");
-    if (const std::string expected = spec->check(value); !expected.empty()) {
-      throw Error(descriptor.type + ": parameter '" + name + "': expected " + expected + ", got " +
-                  value.dump());
-    }
-    values[name] = value;
-  }
-  return Params(std::move(values));
-}
 
 class TransformHarness {
  public:
