@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "box_sums.h"
 #include "otsu.h"
 #include "tilth/error.h"
 
@@ -109,11 +110,9 @@ IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
   const IndexInfo& range = info(index_);
   const float bins_per_unit = kBins / (range.high - range.low);
 
-  // Unnormalised: an index is a ratio of channels, so the box's sum will do (49 * 255
-  // fits in 16 bits).
+  // Unnormalised: an index is a ratio of channels, so the box's sum will do.
   thread_local cv::Mat summed, index;
-  const int side = 2 * smoothing_px_ + 1;
-  cv::boxFilter(bgr, summed, CV_16U, {side, side}, {-1, -1}, false, cv::BORDER_REFLECT);
+  box_sums(bgr, smoothing_px_, summed);
   index.create(bgr.size(), CV_32FC1);
   std::array<double, kBins> histogram{};
   switch (index_) {
