@@ -144,8 +144,10 @@ def main():
     with open(os.path.join(folder, "log.txt"), "a") as log:
         recordings = [simulate(tilth, folder, preset, args.seed, args, log)
                       for preset in args.presets]
-        passes = [simulate(tilth, os.path.join(folder, "seed%d" % args.field_seed), preset,
-                           args.field_seed, args, log) for preset in args.presets]
+        passes = []
+        if any(learned[5] == "field" for learned in learned_ones):
+            passes = [simulate(tilth, os.path.join(folder, "seed%d" % args.field_seed), preset,
+                               args.field_seed, args, log) for preset in args.presets]
         for held in recordings:
             variants = []
             for name, _, settings in rules:

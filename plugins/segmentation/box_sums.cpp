@@ -57,17 +57,20 @@ void box_sums(const cv::Mat& bgr, int radius, cv::Mat& summed) {
   const int side = 2 * radius + 1;
   summed.create(bgr.size(), CV_16UC3);
   if (bgr.empty()) return;
-  // The image's pixels from `radius` left of the view to `radius` right of it, reflected
-  // at the image's edges: as columns of the whole image.
-  thread_local std::vector<int> columns;
-  columns.resize(static_cast<std::size_t>(width + 2 * radius));
-  for (int i = 0; i < width + 2 * radius; ++i) {
-    columns[static_cast<std::size_t>(i)] = reflect(offset.x - radius + i, whole.width);
-  }
+  // Where the boxes reach past the image's left or right edge, each row is copied with
+  // the image's pixels from `radius` left of the view to `radius` right of it, reflected
+  // there: `columns` are their columns in the whole image.
   const bool inside = offset.x - radius >= 0 && offset.x + width + radius <= whole.width;
+  thread_local std::vector<int> columns;
   thread_local std::vector<std::uint8_t> padded;
+  if (!inside) {
+    columns.resize(static_cast<std::size_t>(width + 2 * radius));
+    for (int i = 0; i < width + 2 * radius; ++i) {
+      columns[static_cast<std::size_t>(i)] = reflect(offset.x - radius + i, whole.width);
+    }
+    padded.resize(3 * columns.size());
+  }
   thread_local std::vector<std::uint16_t> across;  // one row of sums per box row, in a ring
-  padded.resize(static_cast<std::size_t>(3 * (width + 2 * radius)));
   const std::size_t row_values = static_cast<std::size_t>(3 * width);
   across.resize(static_cast<std::size_t>(side) * row_values);
   // Rows of the whole image from the view's first row.
