@@ -100,18 +100,22 @@ class Validator {
       }
       const ParamValue& given = found->second;
       json value = given.value;
-      const bool textual = param.type == ParamType::kString || param.type == ParamType::kPath ||
-                           param.type == ParamType::kChoice;
+      const bool is_path = param.type == ParamType::kPath || param.type == ParamType::kOutputPath;
+      const bool textual =
+          is_path || param.type == ParamType::kString || param.type == ParamType::kChoice;
       if (given.command_line_text && textual) value = *given.command_line_text;
       if (const std::string expected = param.check(value); !expected.empty()) {
         diagnostics_.add(given.where, "parameter '" + param.name + "': expected " + expected +
                                           ", got " + describe_value(value));
         continue;
       }
-      if (param.type == ParamType::kPath && !value.get<std::string>().empty()) {
+      if (is_path && !value.get<std::string>().empty()) {
+        // What a stage writes lands where the run is started (a service's state
+        // directory), never beside a graph file that may sit in a read-only /etc.
+        const fs::path base =
+            param.type == ParamType::kOutputPath ? fs::current_path() : given.base_dir;
         const fs::path path = value.get<std::string>();
-        value = path.is_absolute() ? path.string()
-                                   : (given.base_dir / path).lexically_normal().string();
+        value = path.is_absolute() ? path.string() : (base / path).lexically_normal().string();
       }
       values[param.name] = std::move(value);
     }

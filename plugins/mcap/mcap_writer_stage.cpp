@@ -378,7 +378,7 @@ StageDescriptor describe() {
       PortSpec::of<CameraStatus>("cameras", "the cameras' health").optional(),
   };
   d.params = {
-      ParamSpec::path("path", std::nullopt)
+      ParamSpec::output_path("path", std::nullopt)
           .describe("the MCAP file to create (replaced if it exists)"),
       ParamSpec::choice("compression", {"zstd", "lz4", "none"}, "zstd")
           .describe("chunk compression"),

@@ -236,7 +236,7 @@ StageDescriptor describe() {
       PortSpec::of<GroundTruth>("truth", "ground truth distance and mask, when known").optional(),
   };
   d.params = {
-      ParamSpec::path("path", std::nullopt).describe("the recording folder to create"),
+      ParamSpec::output_path("path", std::nullopt).describe("the recording folder to create"),
       ParamSpec::path("calibration", std::nullopt)
           .describe("the rig's calibration file; copied into the folder as rig.calib.json"),
       ParamSpec::boolean("overwrite", false)

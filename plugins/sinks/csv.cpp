@@ -213,7 +213,7 @@ StageDescriptor describe() {
   d.inputs = {PortSpec::of<GroundDistance>("distance", "the measurement"),
               PortSpec::of<GroundTruth>("truth", "ground truth, when known").optional()};
   d.params = {
-      ParamSpec::path("path", std::nullopt).describe("CSV file to write (replaced)"),
+      ParamSpec::output_path("path", std::nullopt).describe("CSV file to write (replaced)"),
       ParamSpec::integer("rotate_bytes", 0)
           .range(0, std::nullopt)
           .in_unit("bytes")

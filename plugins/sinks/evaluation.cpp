@@ -193,7 +193,7 @@ StageDescriptor describe() {
           .optional(),
   };
   d.params = {
-      ParamSpec::path("path", std::nullopt).describe("JSON-lines file to write (replaced)"),
+      ParamSpec::output_path("path", std::nullopt).describe("JSON-lines file to write (replaced)"),
       ParamSpec::boolean("save_images", false)
           .describe("also save each frame's mask, truth mask (PNG) and colour (JPEG) in the "
                     "folders mask/, truth/, color/ of PATH_STEM.images beside the file"),

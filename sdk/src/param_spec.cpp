@@ -60,6 +60,8 @@ std::string_view to_string(ParamType type) {
       return "string";
     case ParamType::kPath:
       return "path";
+    case ParamType::kOutputPath:
+      return "output path";
     case ParamType::kChoice:
       return "choice";
     case ParamType::kJson:
@@ -82,6 +84,9 @@ ParamSpec ParamSpec::string(std::string name, std::optional<std::string> default
 }
 ParamSpec ParamSpec::path(std::string name, std::optional<std::string> default_value) {
   return make(std::move(name), ParamType::kPath, or_null(default_value));
+}
+ParamSpec ParamSpec::output_path(std::string name, std::optional<std::string> default_value) {
+  return make(std::move(name), ParamType::kOutputPath, or_null(default_value));
 }
 ParamSpec ParamSpec::choice(std::string name, std::vector<std::string> choices,
                             std::string default_value) {
@@ -124,6 +129,7 @@ std::string ParamSpec::check(const nlohmann::json& value) const {
     case ParamType::kString:
       return value.is_string() ? "" : "a string";
     case ParamType::kPath:
+    case ParamType::kOutputPath:
       // An empty path is "none", for a parameter whose default is none.
       return value.is_string() && (!value.get<std::string>().empty() || default_value == "")
                  ? ""

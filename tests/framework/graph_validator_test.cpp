@@ -147,7 +147,29 @@ TEST_F(GraphValidatorTest, ParametersAreChecked) {
           ": parameter 'gain': expected a number in [0, 10], got 11\n" +
           at("/nodes/out/params/mode") +
           ": parameter 'mode': expected one of 'fast', 'exact', got \"slow\"\n" + at("/nodes/p") +
-          ": missing required parameter 'file' (path: where to write)");
+          ": missing required parameter 'file' (path: a file to read)");
+}
+
+TEST_F(GraphValidatorTest, OutputPathsAreRelativeToTheWorkingDirectoryInputPathsToTheFile) {
+  file_ = dir_.write("g.json", R"({"nodes": {"src": {"type": "test.counter"},
+                                            "out": {"type": "test.record",
+                                                    "params": {"file": "in/x.txt", "log": "out/y.csv"}}},
+                                  "edges": [["src.out", "out.in"]]})");
+  const ValidatedGraph graph = validate_graph(load_graph(file_), registry_);
+  EXPECT_EQ(graph.nodes[1].params.path("file"), dir_.path() / "in/x.txt");
+  EXPECT_EQ(graph.nodes[1].params.path("log"), std::filesystem::current_path() / "out/y.csv");
+
+  const ValidatedGraph defaults =
+      validate_graph(load_graph(dir_.write("d.json", R"({"nodes": {"src": {"type": "test.counter"},
+                                                    "out": {"type": "test.record"}},
+                                          "edges": [["src.out", "out.in"]]})")),
+                     registry_);
+  EXPECT_EQ(defaults.nodes[1].params.path("log"), "record.log");  // defaults stay as declared
+
+  GraphOverrides absolute;
+  absolute.params = {{"out.log", "/var/lib/tilth/seeder.csv"}};
+  EXPECT_EQ(validate_graph(load_graph(file_, absolute), registry_).nodes[1].params.path("log"),
+            "/var/lib/tilth/seeder.csv");
 }
 
 TEST_F(GraphValidatorTest, CommandLineValuesTakeTheParameterType) {

@@ -58,14 +58,16 @@ class MachineGraphs(unittest.TestCase):
         stand-in PLC); returns the CSV rows and the register blocks read."""
         tmp = tempfile.mkdtemp(prefix="tilth-%s-" % machine)
         self.addCleanup(shutil.rmtree, tmp, ignore_errors=True)
+        # The graph's own log path ("seeder.csv") is an output: it lands in the working
+        # directory, as a service's in /var/lib/tilth/GRAPH, not beside the graph file.
         log = os.path.join(tmp, machine + ".csv")
         command = [TILTH, "run", os.path.join(GRAPHS, "simulated", machine + ".json"), "--quiet",
-                   "--var", "log=" + log, "--set", "camera.frames=%d" % FRAMES,
+                   "--set", "camera.frames=%d" % FRAMES,
                    "--set", "camera.fps=%d" % FPS, "--set", "runtime.when_full=block"]
         for setting in plc_settings:
             command += ["--set", setting]
-        run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                               text=True)
+        run = subprocess.Popen(command, cwd=tmp, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, text=True)
         blocks = []
         try:
             wait_for_port(port, run)

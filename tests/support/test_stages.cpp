@@ -253,7 +253,8 @@ void register_test_stages(StageRegistry& registry) {
                         {ParamSpec::integer("delay_us", 0).range(0, std::nullopt).describe("pace"),
                          ParamSpec::number("gain", 1.0).range(0, 10).in_unit("dB").describe("x"),
                          ParamSpec::choice("mode", {"fast", "exact"}, "fast").describe("mode"),
-                         ParamSpec::path("file", "record.txt").describe("where to write")},
+                         ParamSpec::path("file", "record.txt").describe("a file to read"),
+                         ParamSpec::output_path("log", "record.log").describe("a file to write")},
                         Concurrency::kSerial, factory<Record>()),
                "test_stages");
   registry.add(describe("test.lossy", {count("in")}, {},
@@ -264,7 +265,7 @@ void register_test_stages(StageRegistry& registry) {
                         factory<MetricsProbe>()),
                "test_stages");
   registry.add(describe("test.needs_path", {count("in")}, {},
-                        {ParamSpec::path("file", std::nullopt).describe("where to write")},
+                        {ParamSpec::path("file", std::nullopt).describe("a file to read")},
                         Concurrency::kSerial, factory<Record>()),
                "test_stages");
 }

@@ -16,9 +16,10 @@ enum class ParamType {
   kInteger,
   kNumber,
   kString,
-  kPath,    // a string; relative paths resolve against the file (or directory) that set it
-  kChoice,  // a string from a fixed list
-  kJson,    // any JSON value; the stage checks its shape
+  kPath,        // a file the stage reads; relative paths resolve against the graph file
+  kOutputPath,  // a file the stage writes; relative paths resolve against the working directory
+  kChoice,      // a string from a fixed list
+  kJson,        // any JSON value; the stage checks its shape
 };
 
 std::string_view to_string(ParamType type);
@@ -38,6 +39,7 @@ struct ParamSpec {
   static ParamSpec number(std::string name, std::optional<double> default_value);
   static ParamSpec string(std::string name, std::optional<std::string> default_value);
   static ParamSpec path(std::string name, std::optional<std::string> default_value);
+  static ParamSpec output_path(std::string name, std::optional<std::string> default_value);
   static ParamSpec choice(std::string name, std::vector<std::string> choices,
                           std::string default_value);
   static ParamSpec json(std::string name, nlohmann::json default_value);
