@@ -12,9 +12,9 @@
 // Invariant: a pixel gets a colour only when its status is kValid; every other pixel is
 // black and says why: kNoDepth (NaN depth), kOutsideColor (behind the colour camera or
 // outside its image), kOccluded (the colour camera sees a nearer point there),
-// kNotRegistered (its row is outside the region of interest and the 8 px around it that
-// the segmentation reads). The z-buffer always holds every depth pixel, so occlusion
-// inside the region is the same as in a whole image.
+// kNotRegistered (it is outside the region of interest and the 8 px around it that the
+// segmentation reads, its columns rounded out to whole vectors). The z-buffer always holds
+// every depth pixel, so occlusion inside the region is the same as in a whole image.
 //
 // A colour image that is a window of the calibrated image (its camera reads out a region
 // of interest: ColorImage::sensor_offset) is registered with the calibration of that
@@ -164,22 +164,35 @@ Visibility visibility(const Scratch& scratch, const OcclusionCells& cells, float
           RegisteredColor::kOccluded};
 }
 
-// Rows [first, last) of the depth grid are registered.
-struct Rows {
-  int first;
-  int last;
+// The part of the depth grid registered: rows [first_row, last_row), and in them columns
+// [first_column, last_column), from and to whole vectors of kRowLanes (or the row's end),
+// so that the kernels read the located rows as they would whole.
+struct Registered {
+  int first_row;
+  int last_row;
+  int first_column;
+  int last_column;
+
+  static Registered around(const cv::Rect& region, int depth_width) {
+    return {
+        region.y, region.y + region.height, region.x / kRowLanes * kRowLanes,
+        std::min(depth_width, (region.x + region.width + kRowLanes - 1) / kRowLanes * kRowLanes)};
+  }
+  int columns() const { return last_column - first_column; }
 };
 
 void register_nearest(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                      const NearestPixels& pixels, float occlusion_tolerance_mm, Rows rows,
-                      Scratch& scratch, RegisteredColor& out) {
+                      const NearestPixels& pixels, float occlusion_tolerance_mm,
+                      Registered registered, Scratch& scratch, RegisteredColor& out) {
   fill_z_buffer(map, cells, depth, pixels.addressing, false, scratch);
   const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
-  for (int v = rows.first; v < rows.last; ++v) {
+  const int u = registered.first_column;
+  for (int v = registered.first_row; v < registered.last_row; ++v) {
     const LocatedRow row = scratch.locate_second(map, v);
-    map.kernels().resolve(seen, pixels.word, map.depth_width(), depth.ptr<float>(v), row.depth_mm,
-                          row.cell, row.key, out.status.ptr<std::uint8_t>(v),
-                          out.bgr.ptr<std::uint8_t>(v));
+    map.kernels().resolve(seen, pixels.word, registered.columns(), depth.ptr<float>(v) + u,
+                          row.depth_mm + u, row.cell + u, row.key + u,
+                          out.status.ptr<std::uint8_t>(v) + u,
+                          out.bgr.ptr<std::uint8_t>(v) + 3 * u);
   }
 }
 
@@ -209,20 +222,20 @@ Bgr bilinear_sample(const Sampler& sampler, float u, float v, int width, int hei
 
 template <class Sampler>
 void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                       const Sampler& sampler, const float occlusion_tolerance_mm, Rows rows,
-                       Scratch& scratch, RegisteredColor& out) {
+                       const Sampler& sampler, const float occlusion_tolerance_mm,
+                       Registered registered, Scratch& scratch, RegisteredColor& out) {
   const Sampler colors = sampler;  // a local: see LocatedRow
   fill_z_buffer(map, cells, depth, colors.addressing(), true, scratch);
   const float* const nearest_mm = scratch.nearest_mm.data();
   const int outside = cells.grid().outside;
   const int color_width = map.color_width();
   const int color_height = map.color_height();
-  for (int v = rows.first; v < rows.last; ++v) {
+  for (int v = registered.first_row; v < registered.last_row; ++v) {
     const LocatedRow row = scratch.locate_second(map, v);
     const auto* z = depth.ptr<float>(v);
     auto* status = out.status.ptr<std::uint8_t>(v);
     auto* bgr = out.bgr.ptr<std::uint8_t>(v);
-    for (int u = 0; u < map.depth_width(); ++u) {
+    for (int u = registered.first_column; u < registered.last_column; ++u) {
       const int cell = row.cell[u];
       const bool visible = row.depth_mm[u] <= nearest_mm[cell] + occlusion_tolerance_mm;
       status[u] = visible            ? RegisteredColor::kValid
@@ -294,15 +307,15 @@ class ProjectiveRegistration final : public Transform {
     auto out = outputs_.acquire();
     reuse_or_create(out->bgr, map.depth_height(), map.depth_width(), CV_8UC3);
     reuse_or_create(out->status, map.depth_height(), map.depth_width(), CV_8UC1);
-    const cv::Rect region = roi_.around(depth.mm.size(), RegionOfInterest::kMarginPx);
-    const Rows rows{region.y, region.y + region.height};
-    mark_not_registered(rows, *out);
+    const Registered registered = Registered::around(
+        roi_.around(depth.mm.size(), RegionOfInterest::kMarginPx), map.depth_width());
+    mark_not_registered(registered, *out);
     const auto scratch = scratch_.acquire();
     if (bilinear_) {
-      register_bilinear(geometry, depth.mm, color, rows, *scratch, *out);
+      register_bilinear(geometry, depth.mm, color, registered, *scratch, *out);
     } else {
       register_nearest(map, geometry.cells, depth.mm, nearest_pixels(color.pixels, color.format),
-                       occlusion_tolerance_mm_, rows, *scratch, *out);
+                       occlusion_tolerance_mm_, registered, *scratch, *out);
     }
     warn_if_window_too_small(*out, depth.mm.size(), geometry_held);
     frame.set_output(0, std::move(out));
@@ -351,10 +364,10 @@ class ProjectiveRegistration final : public Transform {
 
   // Bilinear sampling blends demosaiced pixels.
   void register_bilinear(const Geometry& geometry, const cv::Mat& depth, const ColorImage& color,
-                         Rows rows, Scratch& scratch, RegisteredColor& out) const {
+                         Registered registered, Scratch& scratch, RegisteredColor& out) const {
     const auto run = [&](const auto& sampler) {
       registration::register_bilinear(geometry.map, geometry.cells, depth, sampler,
-                                      occlusion_tolerance_mm_, rows, scratch, out);
+                                      occlusion_tolerance_mm_, registered, scratch, out);
     };
     switch (color.format) {
       case PixelFormat::kBgr8:
@@ -372,13 +385,25 @@ class ProjectiveRegistration final : public Transform {
     }
   }
 
-  // The rows outside `rows`; the images are continuous (reuse_or_create).
-  static void mark_not_registered(Rows rows, RegisteredColor& out) {
-    for (const auto [first, last] : {Rows{0, rows.first}, Rows{rows.last, out.status.rows}}) {
-      const auto count = static_cast<std::size_t>(last - first);
-      if (count == 0) continue;
-      std::memset(out.status.ptr(first), RegisteredColor::kNotRegistered, count * out.status.step);
-      std::memset(out.bgr.ptr(first), 0, count * out.bgr.step);
+  // Every pixel outside `registered`; the images are continuous (reuse_or_create), so a
+  // run of pixels may go on from one row's end into the next row's start.
+  static void mark_not_registered(const Registered& registered, RegisteredColor& out) {
+    const auto mark = [&out](int row, int column, int count) {
+      if (count <= 0) return;
+      std::memset(out.status.ptr(row) + column, RegisteredColor::kNotRegistered,
+                  static_cast<std::size_t>(count));
+      std::memset(out.bgr.ptr(row) + 3 * column, 0, 3 * static_cast<std::size_t>(count));
+    };
+    const int width = out.status.cols;
+    const int first = registered.first_row, last = registered.last_row;
+    if (first == last) return mark(0, 0, width * out.status.rows);
+    // Before the first registered pixel, between a row's last and the next row's first,
+    // and after the last.
+    mark(0, 0, first * width + registered.first_column);
+    for (int row = first; row < last; ++row) {
+      const int to_next =
+          row + 1 < last ? registered.first_column : (out.status.rows - row - 1) * width;
+      mark(row, registered.last_column, width - registered.last_column + to_next);
     }
   }
 

@@ -12,6 +12,7 @@
 //   kMappingPx of a rounding tie (x.5) or of the image edge, where either answer is
 //   right to within the mapping's accuracy.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -533,31 +534,50 @@ TEST(ProjectiveRegistration, ARegionIsRegisteredAsInTheWholeImage) {
   const CalibrationFile file(document);
   cv::Mat hidden_mm;
   const cv::Mat depth = box_on_a_plane(ref::rig_from(document), hidden_mm);
-  const auto whole = register_color(*make_registration(file.path()), depth, coordinate_image());
-
-  int occluded_in_bands = 0;
-  for (const int y : {0, 100, 160, 220, 280, 340, 440}) {
-    const json roi = {{"x", 200}, {"y", y}, {"width", 240}, {"height", 40}};
-    const auto part = register_color(*make_registration(file.path(), "nearest", 10.0, "auto", roi),
-                                     depth, coordinate_image());
-    // Rows y - 8 .. y + 48 (kMarginPx around the region), clipped to the image.
-    const cv::Range band(std::max(y - RegionOfInterest::kMarginPx, 0),
-                         std::min(y + 40 + RegionOfInterest::kMarginPx, depth.rows));
-    for (int v = 0; v < depth.rows; ++v) {
-      const bool inside = v >= band.start && v < band.end;
-      const cv::Mat status = part->status.row(v);
-      if (inside) {
-        EXPECT_EQ(cv::countNonZero(status != whole->status.row(v)), 0) << "row " << v;
-        EXPECT_EQ(cv::norm(part->bgr.row(v), whole->bgr.row(v), cv::NORM_INF), 0) << "row " << v;
-      } else {
-        EXPECT_EQ(cv::countNonZero(status != RegisteredColor::kNotRegistered), 0) << "row " << v;
-        EXPECT_EQ(cv::countNonZero(part->bgr.row(v).reshape(1)), 0) << "row " << v;
+  for (const std::string interpolation : {"nearest", "bilinear"}) {
+    SCOPED_TRACE(interpolation);
+    const auto whole =
+        register_color(*make_registration(file.path(), interpolation), depth, coordinate_image());
+    int occluded_in_bands = 0;
+    // Bands at every height; their columns from whole vectors (x 200) or not, and one
+    // reaching the image's right edge.
+    for (const auto [y, x, width] : {std::array{0, 200, 240},
+                                     {100, 203, 237},
+                                     {160, 17, 300},
+                                     {220, 200, 240},
+                                     {280, 500, 140},
+                                     {340, 203, 237},
+                                     {440, 200, 240}}) {
+      const json roi = {{"x", x}, {"y", y}, {"width", width}, {"height", 40}};
+      const auto part =
+          register_color(*make_registration(file.path(), interpolation, 10.0, "auto", roi), depth,
+                         coordinate_image());
+      // kMarginPx around the region, clipped to the image; its columns rounded out to whole
+      // vectors of 16.
+      const int margin = RegionOfInterest::kMarginPx;
+      const cv::Range rows(std::max(y - margin, 0), std::min(y + 40 + margin, depth.rows));
+      const cv::Range columns((x - margin) / 16 * 16,
+                              std::min((x + width + margin + 15) / 16 * 16, depth.cols));
+      for (int v = 0; v < depth.rows; ++v) {
+        for (int u = 0; u < depth.cols; ++u) {
+          const bool inside =
+              v >= rows.start && v < rows.end && u >= columns.start && u < columns.end;
+          const auto status = part->status.at<std::uint8_t>(v, u);
+          const auto bgr = part->bgr.at<cv::Vec3b>(v, u);
+          if (inside) {
+            ASSERT_EQ(status, whole->status.at<std::uint8_t>(v, u)) << "at " << u << ", " << v;
+            ASSERT_EQ(bgr, whole->bgr.at<cv::Vec3b>(v, u)) << "at " << u << ", " << v;
+          } else {
+            ASSERT_EQ(status, RegisteredColor::kNotRegistered) << "at " << u << ", " << v;
+            ASSERT_EQ(bgr, cv::Vec3b()) << "at " << u << ", " << v;
+          }
+        }
       }
+      occluded_in_bands +=
+          cv::countNonZero(part->status(rows, columns) == RegisteredColor::kOccluded);
     }
-    occluded_in_bands +=
-        cv::countNonZero(part->status.rowRange(band) == RegisteredColor::kOccluded);
+    EXPECT_GT(occluded_in_bands, 500);  // the bands hold the case
   }
-  EXPECT_GT(occluded_in_bands, 500);  // the bands hold the case
 }
 
 std::string process_error(Transform& stage, const cv::Mat& depth, const cv::Mat& color,
