@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -59,22 +60,32 @@ float index_of(float b, float g, float r) {
   return 60 * ((r - g) / delta + 4);
 }
 
-// Writes each pixel's index and counts the trusted ones into the histogram. Neighbouring
-// pixels often fall in one bin: counting them in turn into four histograms keeps each
-// count from waiting for the one before.
+// Writes each pixel's index and counts the trusted ones into the histogram. The channels
+// are first taken apart into rows of floats, so that the index is computed a vector at a
+// time (the same operations in the same order: the same floats). Neighbouring pixels
+// often fall in one bin: counting them in turn into four histograms keeps each count from
+// waiting for the one before.
 template <ColorIndex kIndex>
 void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const IndexInfo& range,
                          cv::Mat& index, std::array<double, kBins>& histogram) {
   constexpr int kLanes = 4;
   const float bins_per_unit = kBins / (range.high - range.low);
   std::array<std::array<std::uint32_t, kBins>, kLanes> counts{};
+  thread_local std::vector<float> blue, green, red;
+  for (auto* channel : {&blue, &green, &red}) channel->resize(summed.cols);
+  float* const b = blue.data();
+  float* const g = green.data();
+  float* const r = red.data();
   for (int row = 0; row < summed.rows; ++row) {
-    const auto* in = summed.ptr<cv::Vec3w>(row);
+    const auto* in = summed.ptr<std::uint16_t>(row);
     const auto* skip = untrusted.ptr<std::uint8_t>(row);
     auto* out = index.ptr<float>(row);
     for (int col = 0; col < summed.cols; ++col) {
-      out[col] = index_of<kIndex>(in[col][0], in[col][1], in[col][2]);
+      b[col] = in[3 * col];
+      g[col] = in[3 * col + 1];
+      r[col] = in[3 * col + 2];
     }
+    for (int col = 0; col < summed.cols; ++col) out[col] = index_of<kIndex>(b[col], g[col], r[col]);
     for (int col = 0; col < summed.cols; ++col) {
       const float value = out[col];
       if (skip[col] != 0 || std::isnan(value)) continue;
