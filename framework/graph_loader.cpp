@@ -24,6 +24,9 @@
 namespace tilth {
 namespace {
 
+// A reference to a variable in a parameter's value: ${NAME}.
+const std::regex kReference(R"(\$\{([A-Za-z_][A-Za-z0-9_]*)\})");
+
 // ordered_json keeps nodes and keys in the order written, so problems are reported in
 // file order.
 using json = nlohmann::ordered_json;
@@ -132,7 +135,7 @@ class Loader {
         continue;
       }
       node->params[param] = {nlohmann::json(parse_value(setting.value, where)), where,
-                             fs::current_path(), setting.value};
+                             fs::current_path(), setting.value, std::nullopt};
     }
   }
 
@@ -201,10 +204,8 @@ class Loader {
       return result;
     }
     if (!value.is_string()) return value;
-    static const std::regex kReference(R"(\$\{([A-Za-z_][A-Za-z0-9_]*)\})");
+    if (const auto variable = whole_reference(value)) return lookup(*variable, variables, where);
     const std::string text = value.get<std::string>();
-    std::smatch whole;
-    if (std::regex_match(text, whole, kReference)) return lookup(whole[1], variables, where);
     std::string result;
     auto begin = text.cbegin();
     for (std::sregex_iterator it(text.begin(), text.end(), kReference), end; it != end; ++it) {
@@ -214,6 +215,16 @@ class Loader {
     }
     result.append(begin, text.cend());
     return result;
+  }
+
+  // The variable a value is, when it is one reference and nothing else ("${roi}"): the
+  // variable's value itself, of any JSON type.
+  static std::optional<std::string> whole_reference(const json& value) {
+    if (!value.is_string()) return std::nullopt;
+    const std::string text = value.get<std::string>();
+    std::smatch whole;
+    if (!std::regex_match(text, whole, kReference)) return std::nullopt;
+    return whole[1].str();
   }
 
   // Relative paths in a value resolve against the file's directory, unless the value
@@ -366,9 +377,8 @@ class Loader {
       for (const auto& [param, value] : body["params"].items()) {
         const Location param_where = params_where.child(param);
         node->params[param] = {nlohmann::json(substitute(value, variables, param_where)),
-                               param_where,
-                               base_dir(value, dir),
-                               {}};
+                               param_where, base_dir(value, dir), std::nullopt,
+                               whole_reference(value)};
       }
     }
   }

@@ -23,6 +23,10 @@ struct ParamValue {
   std::filesystem::path base_dir;
   // Set for --set values, which are typed by the parameter they set.
   std::optional<std::string> command_line_text;
+  // Set when the file wrote the value as one of its variables ("${roi}"): wiring the file
+  // shares among its nodes rather than a setting of this stage (`tilth ab` keeps it for a
+  // stage type replacing the node's).
+  std::optional<std::string> variable;
 };
 
 struct NodeSpec {

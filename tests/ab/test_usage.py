@@ -1,7 +1,7 @@
 """`tilth ab` on bad input: each mistake gives a message saying what, where and what was
 expected, and nothing runs. Also: `tilth` finds the tilth-ab program, the progress bar
-appears only on a terminal, and a graph that fails is shown in the report and fails
-the run."""
+appears only on a terminal, a graph that fails is shown in the report and fails the
+run, and a node given another stage type keeps the chain's region."""
 import json
 import os
 import pty
@@ -202,6 +202,25 @@ class UsageTest(unittest.TestCase):
         self.assertEqual(rows["broken"]["figures"]["frames"], 0)
         with open(os.path.join(self.out, "report.html")) as f:
             self.assertIn("Some graphs failed", f.read())
+
+    def test_a_replaced_stage_keeps_the_chains_region(self):
+        """segment.type replaces the fusion node and drops its parameters, but not the
+        chain's "roi": "${roi}": the new stage segments the region the registration colours
+        and the estimation reads, and only that is judged."""
+        result = ab(CASE_C, "--variant", "index:segment.type=segmentation.color_index",
+                    "--var", CALIBRATION, "--out", self.out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        with open(os.path.join(self.out, "runs", "index", "case_c", "frames.jsonl")) as f:
+            frames = [json.loads(line) for line in f]
+        # The half rig's 320x240 image: its middle half (160x120) and the 8 px around it.
+        segmented = (160 + 16) * (120 + 16)
+        for frame in frames:
+            mask = frame["mask"]
+            judged = mask["tp"] + mask["fp"] + mask["fn"] + mask["tn"]
+            self.assertEqual(judged + mask["ignored"], 320 * 240)
+            # Less the pixels of mixed truth.
+            self.assertLessEqual(judged, segmented)
+            self.assertGreater(judged, 0.85 * segmented)
 
 
 if __name__ == "__main__":

@@ -202,6 +202,23 @@ TEST(GraphLoader, APathStartingWithACommandLineVariableIsRelativeToTheWorkingDir
   EXPECT_EQ(node(typed, "also").params.at("file").base_dir, file.parent_path());
 }
 
+// A value that is one variable and nothing else is the file's wiring: the loader says which.
+TEST(GraphLoader, AValueThatIsOneVariableNamesIt) {
+  TempDir dir;
+  const auto file = dir.write("g.json", R"({
+    "variables": {"log": "default.csv", "folder": "logs", "count": 3},
+    "nodes": {"src": {"type": "test.counter", "params": {"count": "${count}"}},
+              "out": {"type": "test.record", "params": {"file": "${log}", "mode": "exact"}},
+              "also": {"type": "test.record", "params": {"file": "${folder}/${log}"}}}
+  })");
+  const GraphSpec graph = load_graph(file, {{}, {{"log", "run.csv"}}});
+  EXPECT_EQ(node(graph, "src").params.at("count").value, 3);
+  EXPECT_EQ(node(graph, "src").params.at("count").variable, "count");
+  EXPECT_EQ(node(graph, "out").params.at("file").variable, "log");
+  EXPECT_EQ(node(graph, "out").params.at("mode").variable, std::nullopt);
+  EXPECT_EQ(node(graph, "also").params.at("file").variable, std::nullopt);
+}
+
 TEST(GraphLoader, ReportsEveryProblemAtOnce) {
   TempDir dir;
   const auto file = dir.write("g.json", R"({

@@ -116,8 +116,11 @@ void write_file(const fs::path& file, const std::string& text) {
   if (error || !out.flush()) throw Error(file.string() + ": cannot write the file");
 }
 
-// Type replacements first: a replaced node keeps only the parameters the variant sets.
-void apply_settings(const Variant& variant, const std::string& prefix, GraphSpec& graph) {
+// Type replacements first: a replaced node keeps the parameters the chain file wires to
+// its variables ("roi": "${roi}") that the new type has too, so that it works on what its
+// neighbours work on, and the parameters the variant sets.
+void apply_settings(const Variant& variant, const std::string& prefix,
+                    const StageRegistry& registry, GraphSpec& graph) {
   for (const bool types : {true, false}) {
     for (const auto& setting : variant.settings) {
       if (setting.replaces_type() != types) continue;
@@ -126,10 +129,14 @@ void apply_settings(const Variant& variant, const std::string& prefix, GraphSpec
       if (types) {
         node->type = setting.value.get<std::string>();  // check_variant made sure
         node->where = setting.where;
-        node->params.clear();
+        const StageRegistry::Entry* replacing = registry.find(node->type);
+        std::erase_if(node->params, [&](const auto& param) {
+          return !param.second.variable || replacing == nullptr ||
+                 replacing->descriptor.param(param.first) == nullptr;
+        });
       } else {
         node->params[setting.param] = {setting.value, setting.where, setting.base_dir,
-                                       setting.command_line_text};
+                                       setting.command_line_text, std::nullopt};
       }
     }
   }
@@ -217,7 +224,7 @@ std::optional<ValidatedGraph> job_graph(const Variant& variant, const Recording&
     // --var sets the chains' variables; a recorded variant has no chain.
     GraphSpec graph = load_graph(
         files.graph, {{}, variant.recorded ? std::vector<Setting>{} : options.variables.variables});
-    apply_settings(variant, job_label(variant, recording) + "/", graph);
+    apply_settings(variant, job_label(variant, recording) + "/", registry, graph);
     return validate_graph(graph, registry);
   } catch (const GraphError& error) {
     take_problems(error, problems);

@@ -30,7 +30,7 @@ void InProcessGraph::add_node(const std::string& name, const std::string& type,
   node.where = Location{program_, "/nodes/" + name};
   for (const auto& [key, value] : params.items()) {
     node.params[key] = ParamValue{value, node.where.child("params").child(key),
-                                  std::filesystem::current_path(), std::nullopt};
+                                  std::filesystem::current_path(), std::nullopt, std::nullopt};
   }
   spec_.nodes.push_back(std::move(node));
 }
@@ -44,8 +44,8 @@ void InProcessGraph::set_from_option(const std::string& node_name, const std::st
   } catch (const JsonError& error) {
     if (!error.malformed()) throw;
   }
-  node(node_name).params[param] =
-      ParamValue{value, Location{program_, option}, std::filesystem::current_path(), text};
+  node(node_name).params[param] = ParamValue{value, Location{program_, option},
+                                             std::filesystem::current_path(), text, std::nullopt};
 }
 
 void InProcessGraph::add_edge(const std::string& from, const std::string& to) {
