@@ -89,12 +89,30 @@ struct LocatedRow {
   const int* cell;        // CellGrid::outside: not in the colour image
 };
 
+// The part of the depth grid registered: rows [first_row, last_row), and in them columns
+// [first_column, last_column), from and to whole vectors of kRowLanes (or the row's end),
+// so that the kernels read the located rows as they would whole.
+struct Registered {
+  int first_row;
+  int last_row;
+  int first_column;
+  int last_column;
+
+  static Registered around(const cv::Rect& region, int depth_width) {
+    return {
+        region.y, region.y + region.height, region.x / kRowLanes * kRowLanes,
+        std::min(depth_width, (region.x + region.width + kRowLanes - 1) / kRowLanes * kRowLanes)};
+  }
+  int columns() const { return last_column - first_column; }
+};
+
 // What a frame in flight needs besides its output: the z-buffer, the depth pixels as the
 // colour camera sees them, and the demosaiced colour image for bilinear sampling of a
-// mosaic. The first pass keeps every row's locations for the second (12 bytes a pixel,
-// 3.7 MB a frame: with 8 or 4 lanes, projecting and locating the rows anew costs more);
-// kept rows include their colour pixels for bilinear sampling only, which reads them in
-// the second pass.
+// mosaic. The first pass keeps the registered rows' locations for the second (12 bytes a
+// pixel, 2 MB a frame for the chain's region: with 8 or 4 lanes, projecting and locating
+// the rows anew costs more), and locates every other row into one spare row, which stays
+// in the nearest cache; kept rows include their colour pixels for bilinear sampling only,
+// which reads them in the second pass.
 struct Scratch {
   // An empty cell's depth: the float whose bytes are all kFarByte, 3.4e38 mm, farther
   // than any point.
@@ -105,9 +123,12 @@ struct Scratch {
   std::vector<int> key, cell;
   cv::Mat demosaiced;  // CV_8UC3
 
-  void prepare(const DepthToColor& map, const OcclusionCells& cells, bool bilinear) {
+  void prepare(const DepthToColor& map, const OcclusionCells& cells, const Registered& registered,
+               bool bilinear) {
+    first_kept_ = registered.first_row;
+    kept_ = registered.last_row - registered.first_row;
     const auto row = static_cast<std::size_t>(map.row_capacity());
-    const auto frame = row * static_cast<std::size_t>(map.depth_height());
+    const auto frame = row * static_cast<std::size_t>(kept_ + 1);
     for (auto* values : {&color_u, &color_v}) values->resize(bilinear ? frame : row);
     color_depth.resize(frame);
     for (auto* values : {&key, &cell}) values->resize(frame);
@@ -138,19 +159,25 @@ struct Scratch {
     LocatedRow located() const { return {u, v, depth_mm, key, cell}; }
   };
 
+  // Row v's slot: its own for a kept row, else the spare one after them.
   Slots slots(const DepthToColor& map, int v) {
     const auto capacity = static_cast<std::size_t>(map.row_capacity());
-    const std::size_t start = static_cast<std::size_t>(v) * capacity;
+    const int slot = v >= first_kept_ && v < first_kept_ + kept_ ? v - first_kept_ : kept_;
+    const std::size_t start = static_cast<std::size_t>(slot) * capacity;
     const std::size_t uv = color_u.size() > start ? start : 0;
     return {color_u.data() + uv, color_v.data() + uv, color_depth.data() + start,
             key.data() + start, cell.data() + start};
   }
+
+  int first_kept_ = 0;
+  int kept_ = 0;
 };
 
 // The first pass: the nearest point of each cell.
 void fill_z_buffer(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
-                   const Addressing& addressing, bool bilinear, Scratch& scratch) {
-  scratch.prepare(map, cells, bilinear);
+                   const Addressing& addressing, const Registered& registered, bool bilinear,
+                   Scratch& scratch) {
+  scratch.prepare(map, cells, registered, bilinear);
   for (int v = 0; v < map.depth_height(); ++v) {
     const LocatedRow row = scratch.locate_first(map, cells, depth, v, addressing);
     map.kernels().keep_nearest(cells.grid(), map.row_capacity(), row.depth_mm, row.cell,
@@ -164,27 +191,10 @@ Visibility visibility(const Scratch& scratch, const OcclusionCells& cells, float
           RegisteredColor::kOccluded};
 }
 
-// The part of the depth grid registered: rows [first_row, last_row), and in them columns
-// [first_column, last_column), from and to whole vectors of kRowLanes (or the row's end),
-// so that the kernels read the located rows as they would whole.
-struct Registered {
-  int first_row;
-  int last_row;
-  int first_column;
-  int last_column;
-
-  static Registered around(const cv::Rect& region, int depth_width) {
-    return {
-        region.y, region.y + region.height, region.x / kRowLanes * kRowLanes,
-        std::min(depth_width, (region.x + region.width + kRowLanes - 1) / kRowLanes * kRowLanes)};
-  }
-  int columns() const { return last_column - first_column; }
-};
-
 void register_nearest(const DepthToColor& map, const OcclusionCells& cells, const cv::Mat& depth,
                       const NearestPixels& pixels, float occlusion_tolerance_mm,
                       Registered registered, Scratch& scratch, RegisteredColor& out) {
-  fill_z_buffer(map, cells, depth, pixels.addressing, false, scratch);
+  fill_z_buffer(map, cells, depth, pixels.addressing, registered, false, scratch);
   const Visibility seen = visibility(scratch, cells, occlusion_tolerance_mm);
   const int u = registered.first_column;
   for (int v = registered.first_row; v < registered.last_row; ++v) {
@@ -225,7 +235,7 @@ void register_bilinear(const DepthToColor& map, const OcclusionCells& cells, con
                        const Sampler& sampler, const float occlusion_tolerance_mm,
                        Registered registered, Scratch& scratch, RegisteredColor& out) {
   const Sampler colors = sampler;  // a local: see LocatedRow
-  fill_z_buffer(map, cells, depth, colors.addressing(), true, scratch);
+  fill_z_buffer(map, cells, depth, colors.addressing(), registered, true, scratch);
   const float* const nearest_mm = scratch.nearest_mm.data();
   const int outside = cells.grid().outside;
   const int color_width = map.color_width();
