@@ -231,11 +231,10 @@ class Loader {
   // starts with a variable set on the command line (`--var log=run.csv`): that path was
   // typed in the working directory.
   fs::path base_dir(const json& value, const fs::path& file_dir) const {
-    static const std::regex kLeadingReference(R"(^\$\{([A-Za-z_][A-Za-z0-9_]*)\})");
     if (!value.is_string()) return file_dir;
     const std::string text = value.get<std::string>();
     std::smatch leading;
-    if (std::regex_search(text, leading, kLeadingReference) &&
+    if (std::regex_search(text, leading, kReference, std::regex_constants::match_continuous) &&
         command_line_variables_.contains(leading[1])) {
       return fs::current_path();
     }

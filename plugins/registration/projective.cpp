@@ -405,8 +405,7 @@ class ProjectiveRegistration final : public Transform {
       std::memset(out.bgr.ptr(row) + 3 * column, 0, 3 * static_cast<std::size_t>(count));
     };
     const int width = out.status.cols;
-    const int first = registered.first_row, last = registered.last_row;
-    if (first == last) return mark(0, 0, width * out.status.rows);
+    const int first = registered.first_row, last = registered.last_row;  // first < last
     // Before the first registered pixel, between a row's last and the next row's first,
     // and after the last.
     mark(0, 0, first * width + registered.first_column);
