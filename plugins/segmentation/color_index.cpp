@@ -25,7 +25,8 @@ class ColorIndexStage final : public Transform {
  public:
   explicit ColorIndexStage(const StageContext& context)
       : index_(parse_color_index(context.params.string("index")),
-               static_cast<int>(context.params.integer("smoothing_px"))),
+               static_cast<int>(context.params.integer("smoothing_px")),
+               static_cast<int>(context.params.integer("max_smoothing_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
         output_(context.params),
         notice_(context.log) {}
@@ -54,7 +55,7 @@ StageDescriptor describe_color_index() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(),   smoothing_px_param(), dilation_px_param(),
+      color_index_param(),   smoothing_px_param(), max_smoothing_px_param(), dilation_px_param(),
       segmented_roi_param(), speckle_px_param(1),  min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;

@@ -31,7 +31,8 @@ class Fusion final : public Transform {
  public:
   explicit Fusion(const StageContext& context)
       : index_(parse_color_index(context.params.string("index")),
-               static_cast<int>(context.params.integer("smoothing_px"))),
+               static_cast<int>(context.params.integer("smoothing_px")),
+               static_cast<int>(context.params.integer("max_smoothing_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
         height_mm_(context.params.number("height_mm")),
         surface_(height_mm_, context.params.number("surface_px"),
@@ -74,9 +75,9 @@ StageDescriptor describe_fusion() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(),   smoothing_px_param(), height_mm_param(),
-      surface_px_param(),    envelope_px_param(),  dilation_px_param(),
-      segmented_roi_param(), speckle_px_param(1),  min_value_param(),
+      color_index_param(), smoothing_px_param(), max_smoothing_px_param(), height_mm_param(),
+      surface_px_param(),  envelope_px_param(),  dilation_px_param(),      segmented_roi_param(),
+      speckle_px_param(1), min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<Fusion>();

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -98,6 +99,36 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
   }
 }
 
+// Whether the noise of the soil's index is at most `limit`: the robust standard deviation
+// (1.4826 MAD / sqrt 2) of the differences between trusted soil pixels 2r+1 columns apart
+// (boxes that do not overlap), on every fourth row; at most `limit` when at least half of
+// those differences are within limit * sqrt 2 / 1.4826. The soil's, because soil is what
+// noise takes away (one cue is enough for residue), and it is often the darker material,
+// whose index varies more; pairs on the soil side of the threshold only, since straw in
+// the light may be quiet where soil in its shadow is not.
+bool soil_quieter_than(const cv::Mat& index, const cv::Mat& untrusted, const IndexInfo& range,
+                       float threshold, int smoothing_px, float limit) {
+  const int apart = 2 * smoothing_px + 1;
+  const float within = limit * std::numbers::sqrt2_v<float> / 1.4826f;
+  const float sign = range.residue_above ? 1.0f : -1.0f;  // soil: sign * index < sign * threshold
+  const float soil_below = sign * threshold;
+  int pairs = 0;
+  int close = 0;
+  for (int row = 0; row < index.rows; row += 4) {
+    const auto* value = index.ptr<float>(row);
+    const auto* skip = untrusted.ptr<std::uint8_t>(row);
+    for (int col = 0; col + apart < index.cols; ++col) {
+      const float a = value[col], b = value[col + apart];
+      // NaN compares false: no colour, no pair.
+      const int soil =
+          (skip[col] | skip[col + apart]) == 0 && sign * a < soil_below && sign * b < soil_below;
+      pairs += soil;
+      close += soil & (std::abs(b - a) <= within);
+    }
+  }
+  return 2 * close >= pairs;
+}
+
 }  // namespace
 
 ColorIndex parse_color_index(const std::string& name) {
@@ -113,17 +144,34 @@ std::vector<std::string> color_index_names() {
   return names;
 }
 
-ResidueIndex::ResidueIndex(ColorIndex index, int smoothing_px)
-    : index_(index), smoothing_px_(smoothing_px) {}
+ResidueIndex::ResidueIndex(ColorIndex index, int smoothing_px, int max_smoothing_px)
+    : index_(index),
+      smoothing_px_(smoothing_px),
+      max_smoothing_px_(std::max(smoothing_px, max_smoothing_px)) {}
 
 IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
                                   cv::Mat& residue) const {
   const IndexInfo& range = info(index_);
+  thread_local cv::Mat index;
+  IndexSplit split = split_at(smoothing_px_, bgr, untrusted, index);
+  while (split.smoothing_px < max_smoothing_px_ &&
+         !soil_quieter_than(index, untrusted, range, split.threshold, split.smoothing_px,
+                            kNoiseShareOfGap * range.min_gap)) {
+    split = split_at(split.smoothing_px + 1, bgr, untrusted, index);
+  }
+  // NaN compares false: no colour, no residue.
+  cv::compare(index, split.threshold, residue, range.residue_above ? cv::CMP_GE : cv::CMP_LT);
+  return split;
+}
+
+IndexSplit ResidueIndex::split_at(int smoothing_px, const cv::Mat& bgr, const cv::Mat& untrusted,
+                                  cv::Mat& index) const {
+  const IndexInfo& range = info(index_);
   const float bins_per_unit = kBins / (range.high - range.low);
 
   // Unnormalised: an index is a ratio of channels, so the box's sum will do.
-  thread_local cv::Mat summed, index;
-  box_sums(bgr, smoothing_px_, summed);
+  thread_local cv::Mat summed;
+  box_sums(bgr, smoothing_px, summed);
   index.create(bgr.size(), CV_32FC1);
   std::array<double, kBins> histogram{};
   switch (index_) {
@@ -144,6 +192,7 @@ IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
   IndexSplit split;
   split.threshold = range.boundary;
   split.min_gap = range.min_gap;
+  split.smoothing_px = smoothing_px;
   if (const auto otsu = otsu_split(histogram)) {
     split.class_gap = static_cast<float>(otsu->upper_mean - otsu->lower_mean) / bins_per_unit;
     if (split.class_gap >= range.min_gap) {
@@ -151,8 +200,6 @@ IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
       split.threshold = range.low + static_cast<float>(otsu->threshold_bin) / bins_per_unit;
     }
   }
-  // NaN compares false: no colour, no residue.
-  cv::compare(index, split.threshold, residue, range.residue_above ? cv::CMP_GE : cv::CMP_LT);
   return split;
 }
 
@@ -160,6 +207,16 @@ std::string IndexSplit::text() const {
   char text[64];
   std::snprintf(text, sizeof text, "class gap %.3g, two materials from %.3g", class_gap, min_gap);
   return text;
+}
+
+ParamSpec max_smoothing_px_param() {
+  return ParamSpec::integer("max_smoothing_px", 3)
+      .range(0, 3)
+      .in_unit("px")
+      .describe(
+          "noisier colours (gain in low light) are averaged over boxes up to (2r+1)^2 until "
+          "the index's noise is under 0.6 of its least gap between materials; at most "
+          "smoothing_px: always smoothing_px");
 }
 
 ParamSpec color_index_param() {

@@ -23,14 +23,23 @@ struct IndexSplit {
   float class_gap = 0;       // between the means of Otsu's two classes (0: no split)
   float min_gap = 0;         // the index's least gap between two materials
   bool two_classes = false;  // false: the frame shows one material, `threshold` is absolute
+  int smoothing_px = 0;      // the box the colours were averaged over: (2r+1)^2
 
   std::string text() const;  // "class gap 0.012, two materials from 0.05"
 };
 
 class ResidueIndex {
  public:
-  // `smoothing_px`: the index is that of the mean colour over a (2r+1)^2 box.
-  ResidueIndex(ColorIndex index, int smoothing_px);
+  // `smoothing_px`: the index is that of the mean colour over a (2r+1)^2 box. Noisier
+  // colours (a camera's gain in low light) are averaged over larger boxes, up to
+  // `max_smoothing_px`, until the noise of the soil's index is under kNoiseShareOfGap of
+  // the index's least gap between two materials.
+  ResidueIndex(ColorIndex index, int smoothing_px, int max_smoothing_px);
+
+  // The simulator's scenes through the paper rig's camera (2 DN of noise) keep the 3x3 box;
+  // at 6 DN heavy cover lost half its visible soil to noise with a 3x3 box, and every
+  // frame with it (docs/accuracy.md, "Noisier cameras").
+  static constexpr float kNoiseShareOfGap = 0.6f;
 
   // Writes 255 into `residue` (CV_8UC1) where a pixel's index is on the residue side of
   // the frame's threshold, 0 elsewhere. The threshold is Otsu's over the pixels not marked
@@ -39,11 +48,16 @@ class ResidueIndex {
   IndexSplit classify(const cv::Mat& bgr, const cv::Mat& untrusted, cv::Mat& residue) const;
 
  private:
+  IndexSplit split_at(int smoothing_px, const cv::Mat& bgr, const cv::Mat& untrusted,
+                      cv::Mat& index) const;
+
   const ColorIndex index_;
   const int smoothing_px_;
+  const int max_smoothing_px_;
 };
 
-// The `index` parameter of the stages that use it.
+// The `index` and `max_smoothing_px` parameters of the stages that use it.
 ParamSpec color_index_param();
+ParamSpec max_smoothing_px_param();
 
 }  // namespace tilth::segmentation
