@@ -18,6 +18,11 @@
 // average out clods and relief; cut at the steps (ground_steps.h), it can do so without
 // averaging a step's two levels.
 //
+// The outlier threshold is `outlier_threshold_mm`, or kBandPerNoise times the soil depths'
+// noise when that is more (depth_noise_mm), up to three times the threshold: a band
+// narrower than the noise splits one surface's points at random, and the mean shift and
+// the fit then settle wherever they start.
+//
 // `neighbourhood_mm` weights each point by a Gaussian of its distance from the tool point
 // across the ground; 0 weighs all points alike. `tool_area_mm` is the scale of the soil
 // that decides which level the tool stands on; 0 lets all the soil decide.
@@ -41,6 +46,7 @@
 #include <Eigen/Dense>
 
 #include "camera_geometry/lens_model.h"
+#include "depth_noise/depth_noise.h"
 #include "estimators.h"
 #include "ground_steps.h"
 #include "plausibility.h"
@@ -291,6 +297,12 @@ class GroundPlaneEstimator final : public Transform {
  public:
   enum Port { kSoilDepth = 0, kColor = 1 };
 
+  // The chain's 3 mm band against the simulator's soil noise, 1.3-2.1 mm: about 1.5 sigma.
+  // At most three times the threshold: depths that are no surface at all (a ToF image of
+  // noise) must not widen the band until they fit.
+  static constexpr double kBandPerNoise = 1.5;
+  static constexpr double kMaxBandPerThreshold = 3.0;
+
   explicit GroundPlaneEstimator(const StageContext& context)
       : region_(context.params.json("roi"), RegionOfInterest::Whole::kMiddleHalf),
         tool_point_mm_(parse_tool_point(context.params.json("tool_point"))),
@@ -346,6 +358,10 @@ class GroundPlaneEstimator final : public Transform {
  private:
   void measure(const Sampling& sampling, const cv::Mat& soil_mm, GroundDistance& out) const {
     const DepthCameraCalibration& camera = sampling.camera;
+    const double band_mm =
+        std::min(kBandPerNoise * depth_noise_mm(soil_mm, sampling.roi,
+                                                static_cast<float>(threshold_mm_ / kBandPerNoise)),
+                 kMaxBandPerThreshold * threshold_mm_);
     thread_local std::vector<SoilPoint> grid;  // every grid pixel; z NaN where no soil
     thread_local std::vector<SoilPoint> points;
     grid.clear();
@@ -369,7 +385,7 @@ class GroundPlaneEstimator final : public Transform {
                      "'stride')");
       return;
     }
-    std::optional<Quadric> surface = fitted_surface(points, *tilt);
+    std::optional<Quadric> surface = fitted_surface(points, *tilt, band_mm);
     if (surface && min_step_mm_ > 0 && cut_at_steps(*surface, points)) {
       if (points.size() < 6) {
         out.invalidate(InvalidCause::kTooLittleSoil,
@@ -377,7 +393,7 @@ class GroundPlaneEstimator final : public Transform {
         return;
       }
       vote_near_the_tool(points);
-      surface = fitted_surface(points, *tilt);
+      surface = fitted_surface(points, *tilt, band_mm);
     }
     if (!surface) {
       out.invalidate(InvalidCause::kNotOneSurface,
@@ -392,7 +408,7 @@ class GroundPlaneEstimator final : public Transform {
     for (const SoilPoint& point : points) {
       votes += point.vote;
       const double residual_mm = surface->residual_mm(point);
-      if (std::abs(residual_mm) > threshold_mm_) continue;
+      if (std::abs(residual_mm) > band_mm) continue;
       inlier_votes += point.vote;
       inlier_weight += point.weight;
       squares += point.weight * residual_mm * residual_mm;
@@ -401,9 +417,8 @@ class GroundPlaneEstimator final : public Transform {
     if (inlier_fraction < min_inlier_fraction_) {
       out.invalidate(InvalidCause::kNotOneSurface,
                      "no surface fits the soil: " + one_decimal(100.0 * inlier_fraction) +
-                         " % of the soil points (by weight) lie within " +
-                         one_decimal(threshold_mm_) + " mm of the tool's < " +
-                         one_decimal(100.0 * min_inlier_fraction_) + " %");
+                         " % of the soil points (by weight) lie within " + one_decimal(band_mm) +
+                         " mm of the tool's < " + one_decimal(100.0 * min_inlier_fraction_) + " %");
       return;
     }
     const double depth_at_tool = surface->depth_at_origin();
@@ -422,12 +437,12 @@ class GroundPlaneEstimator final : public Transform {
 
   // The quadric on the tool's level, re-fitted until it settles; nullopt when the points
   // do not determine one.
-  std::optional<Quadric> fitted_surface(const std::vector<SoilPoint>& points,
-                                        const Tilt& tilt) const {
-    Quadric surface(tool_point_mm_, tool_level(points, tilt, threshold_mm_), tilt);
+  std::optional<Quadric> fitted_surface(const std::vector<SoilPoint>& points, const Tilt& tilt,
+                                        double band_mm) const {
+    Quadric surface(tool_point_mm_, tool_level(points, tilt, band_mm), tilt);
     for (int refit = 0; refit < kMaxRefits; ++refit) {
       const double before = surface.depth_at_origin();
-      if (!surface.refit(points, threshold_mm_)) return std::nullopt;
+      if (!surface.refit(points, band_mm)) return std::nullopt;
       if (std::abs(surface.depth_at_origin() - before) < kLevelSettledMm) break;
     }
     return surface;
@@ -520,7 +535,8 @@ StageDescriptor describe_ground_plane() {
           .range(0.1, 1000)
           .in_unit("mm")
           .describe("soil points farther than this from the surface (along Z) are outliers, "
-                    "and levels farther apart are told apart"),
+                    "and levels farther apart are told apart; on noisier soil 1.5 times its "
+                    "depth noise, up to three times this"),
       ParamSpec::number("min_inlier_fraction", 0.5)
           .range(0, 1)
           .describe("below this fraction of the soil points (weighed by their votes) on the "

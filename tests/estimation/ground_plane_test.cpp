@@ -240,6 +240,23 @@ TEST(GroundPlane, SoilOnlyAroundACoveredToolAreaDecidesTheLevel) {
   EXPECT_NEAR(out.distance_mm, scene.distance_mm, 0.3);
 }
 
+// The chain's estimator on ground three times as noisy as the simulator's soil (6 mm, the
+// sun on a ToF camera). Its 3 mm band holds under half of one surface's points, and the
+// mean shift and the fit settled wherever they began: -0.86 to +0.90 mm over ten seeds,
+// 0.54 mm RMS. The band follows the noise (1.5 sigma, 9 mm): 0.28 mm RMS, -0.08 to -0.53.
+TEST(GroundPlane, NoisyGroundWidensTheBand) {
+  GroundScene scene;
+  scene.tilt_x_deg = 5.0;
+  scene.noise_mm = 6.0;
+  double squares = 0.0;
+  for (scene.seed = 1; scene.seed <= 10; ++scene.seed) {
+    const GroundDistance out = fit_plane(testing::render(scene, paper_camera()), chain_params());
+    ASSERT_TRUE(out.valid) << out.invalid_reason;
+    squares += std::pow(out.distance_mm - scene.distance_mm, 2);
+  }
+  EXPECT_LT(std::sqrt(squares / 10), 0.4);
+}
+
 TEST(GroundPlane, TooLittleVisibleSoilIsInvalid) {
   const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   const GroundDistance out = fit_plane(depth);
@@ -249,8 +266,9 @@ TEST(GroundPlane, TooLittleVisibleSoilIsInvalid) {
   EXPECT_FALSE(out.tilt_x_deg.has_value());
 }
 
-// 70 % of the depths uniform in 300-700 mm: about 30 % + 70 % * 20 / 400 = 33.5 % lie
-// within 10 mm of the soil plane.
+// 70 % of the depths uniform in 300-700 mm. Their "noise" (depth_noise_mm) is the
+// garbage's, far above the 10 mm threshold, so the band widens to its limit, three times
+// the threshold: about 30 % + 70 % * 60 / 400 = 40.5 % lie within 30 mm of the soil plane.
 TEST(GroundPlane, TooFewPointsOnThePlaneIsInvalid) {
   cv::Mat depth = testing::render(GroundScene{}, paper_camera());
   cv::RNG random(7);
@@ -260,9 +278,9 @@ TEST(GroundPlane, TooFewPointsOnThePlaneIsInvalid) {
   const GroundDistance out = fit_plane(depth);
   EXPECT_FALSE(out.valid);
   EXPECT_EQ(out.distance_mm, 0.0);
-  EXPECT_TRUE(out.invalid_reason.starts_with("no surface fits the soil: 3")) << out.invalid_reason;
+  EXPECT_TRUE(out.invalid_reason.starts_with("no surface fits the soil: 4")) << out.invalid_reason;
   EXPECT_TRUE(out.invalid_reason.ends_with(
-      " % of the soil points (by weight) lie within 10.0 mm of the tool's < 50.0 %"))
+      " % of the soil points (by weight) lie within 30.0 mm of the tool's < 50.0 %"))
       << out.invalid_reason;
 }
 
