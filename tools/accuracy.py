@@ -60,10 +60,10 @@ class Scenario:
         # as tilth ab names the recording of its folder
         self.name = preset if rig == "paper" else "%s_%s_rig" % (preset, rig)
 
-    def simulate(self, tilth, folder, frames, seed):
+    def simulate(self, tilth, folder, frames, seed, noise):
         command = [tilth, "simulate", folder, "--preset", self.preset,
                    "--frames", str(self.frames or frames), "--calibration", RIGS[self.rig],
-                   "--color-format", self.color_format, "--seed", str(seed)]
+                   "--color-format", self.color_format, "--seed", str(seed), *noise]
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
 
 
@@ -132,6 +132,16 @@ def number(value, form="%+.2f"):
     return "-" if value is None else form % value
 
 
+def noise_options(args):
+    """The simulator's sensor noise, where the command line sets it."""
+    options = []
+    if args.tof_noise is not None:
+        options += ["--tof-noise", "%g" % args.tof_noise]
+    if args.color_noise is not None:
+        options += ["--color-noise", "%g" % args.color_noise]
+    return options
+
+
 def run_matrix(args, work):
     listed = scenarios(args.small, args.frames)
     folders = []
@@ -139,7 +149,7 @@ def run_matrix(args, work):
         folder = os.path.join(args.recordings or work, scenario.name)
         if not os.path.isdir(folder):
             print("accuracy.py: simulating %s" % scenario.name, file=sys.stderr)
-            scenario.simulate(args.tilth, folder, args.frames, args.seed)
+            scenario.simulate(args.tilth, folder, args.frames, args.seed, noise_options(args))
         folders.append(folder)
     report = os.path.join(work, "ab")
     subprocess.run([args.tilth, "ab", *folders, "--variants", args.variants, "--out", report,
@@ -159,6 +169,7 @@ def print_report(args, listed, variants, cells):
     options = (" --small" if args.small else "") + (
         " --frames %d" % args.frames if args.frames != (3 if args.small else 8) else "")
     options += " --seed %d" % args.seed if args.seed != 1 else ""
+    options += "".join(" " + option for option in noise_options(args))
     print("Produced by `python3 tools/accuracy.py%s > docs/accuracy.md` (after building):"
           % options)
     print("each scenario is a scene preset of docs/simulator.md, seen by a rig (`calib/`) with")
@@ -218,6 +229,12 @@ def main():
     parser.add_argument("--seed", type=int, default=1,
                         help="the simulator's seed: other scenes of the same presets (keep "
                         "their recordings apart)")
+    parser.add_argument("--tof-noise", type=float, metavar="MM",
+                        help="the ToF camera's range noise at 500 mm (the simulator's: 1); "
+                             "keep the recordings apart")
+    parser.add_argument("--color-noise", type=float, metavar="DN",
+                        help="the colour camera's noise (the simulator's: 2); keep the "
+                             "recordings apart")
     parser.add_argument("--variants", default=VARIANTS)
     parser.add_argument("--recordings", metavar="DIR",
                         help="keep the simulated recordings here, and reuse those already here")

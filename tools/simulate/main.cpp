@@ -41,6 +41,9 @@ an image-folder recording.
   --calibration FILE     rig calibration: both cameras' sizes and poses (default: the
                          paper's rig, calib/paper_rig.calib.json)
   --color-format F       bgr8 (default) or a Bayer mosaic: bayer_rggb8, bayer_bggr8, ...
+  --tof-noise MM         ToF range noise (sd) at 500 mm, growing with the range squared
+                         (default 1)
+  --color-noise DN       colour sensor noise (sd, default 2)
   --format mcap|folder   the output format, whatever OUTPUT's extension
   --compression C        MCAP chunk compression: zstd (default), lz4 or none
   --overwrite            replace an existing OUTPUT
@@ -82,7 +85,8 @@ int main(int argc, char** argv) {
   try {
     parsed.emplace(argc, argv, 1,
                    std::set<std::string>{"--preset", "--frames", "--seed", "--fps", "--calibration",
-                                         "--color-format", "--format", "--compression"},
+                                         "--color-format", "--tof-noise", "--color-noise",
+                                         "--format", "--compression"},
                    std::set<std::string>{"--overwrite", "--help"});
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
@@ -137,6 +141,8 @@ int main(int argc, char** argv) {
     pass("--seed", "scene", "seed");
     pass("--fps", "scene", "fps");
     pass("--color-format", "scene", "color_format");
+    pass("--tof-noise", "scene", "noise_mm");
+    pass("--color-noise", "scene", "color_noise");
     pass("--calibration", "scene", "calibration");
     pass("--calibration", "writer", "calibration");
     pass("--compression", "writer", "compression");
