@@ -99,6 +99,13 @@ struct SoilPoint {
   double vote;    // in choosing the tool's level: nearness at the tool area's scale
 };
 
+// A point of the sampling grid, in the camera frame (mm); z NaN where there is no soil.
+struct GridPoint {
+  float x;
+  float y;
+  float z;
+};
+
 // The ground's slopes in the camera frame: Z = Z0 + dz_dx X + dz_dy Y.
 struct Tilt {
   double dz_dx;
@@ -130,9 +137,9 @@ class Quadric {
   // that the fringe of a neighbouring level does not pull the surface onto it; false (and
   // unchanged) when they do not determine a quadric.
   bool refit(const std::vector<SoilPoint>& points, double threshold_mm) {
-    // The normal equations' lower triangle, row by row, and right-hand side, summed in plain
-    // arrays: a fixed 6x6 rank update per point costs several times more through Eigen.
-    std::array<double, 21> lower{};
+    // The normal equations' entries are the weighted moments of u^i v^j (i + j <= 4): 15
+    // sums instead of a 6x6 rank update per point; the right-hand side's, z u^i v^j.
+    std::array<double, kMoments> moments{};
     std::array<double, 6> right{};
     const double per_threshold = 1.0 / threshold_mm;
     for (const SoilPoint& point : points) {
@@ -140,19 +147,24 @@ class Quadric {
       const double relative = (point.z - fitted(t)) * per_threshold;
       if (std::abs(relative) > 1) continue;
       const double biweight = (1 - relative * relative) * (1 - relative * relative);
-      const double weight = point.weight * biweight;
-      std::size_t k = 0;
-      for (std::size_t i = 0; i < 6; ++i) {
-        const double wt = weight * t[i];
-        right[i] += wt * point.z;
-        for (std::size_t j = 0; j <= i; ++j) lower[k++] += wt * t[j];
-      }
+      const double w = point.weight * biweight;
+      const double u = t[1], v = t[2];
+      const double wu = w * u, wv = w * v;
+      const double wuu = wu * u, wuv = wu * v, wvv = wv * v;
+      const double wuuu = wuu * u, wuuv = wuu * v, wuvv = wuv * v, wvvv = wvv * v;
+      const std::array<double, kMoments> added = {w,        wu,       wv,       wuu,      wuv,
+                                                  wvv,      wuuu,     wuuv,     wuvv,     wvvv,
+                                                  wuuu * u, wuuu * v, wuuv * v, wuvv * v, wvvv * v};
+      for (std::size_t i = 0; i < kMoments; ++i) moments[i] += added[i];
+      const double z = point.z;
+      const std::array<double, 6> weighted = {w * z, wu * z, wv * z, wuu * z, wuv * z, wvv * z};
+      for (std::size_t i = 0; i < 6; ++i) right[i] += weighted[i];
     }
     Eigen::Matrix<double, 6, 6> normal;
-    for (std::size_t i = 0, k = 0; i < 6; ++i) {
-      for (std::size_t j = 0; j <= i; ++j, ++k) {
-        normal(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = lower[k];
-        normal(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = lower[k];
+    for (std::size_t i = 0; i < 6; ++i) {
+      for (std::size_t j = 0; j < 6; ++j) {
+        normal(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            moments[kMomentOf[i][j]];
       }
     }
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
@@ -165,7 +177,14 @@ class Quadric {
   }
 
  private:
-  using Terms = std::array<double, 6>;
+  using Terms = std::array<double, 6>;  // 1, u, v, u^2, u v, v^2
+
+  // The moments of u^i v^j by degree, then by i falling: 1; u, v; u^2, u v, v^2; ...
+  static constexpr std::size_t kMoments = 15;
+  // The moment of the product of terms i and j.
+  static constexpr std::size_t kMomentOf[6][6] = {{0, 1, 2, 3, 4, 5},    {1, 3, 4, 6, 7, 8},
+                                                  {2, 4, 5, 7, 8, 9},    {3, 6, 7, 10, 11, 12},
+                                                  {4, 7, 8, 11, 12, 13}, {5, 8, 9, 12, 13, 14}};
 
   Terms terms(double x_mm, double y_mm) const {
     constexpr double kPerScale = 1.0 / kQuadricScaleMm;
@@ -187,7 +206,7 @@ class Quadric {
 
 // The medians of the slopes of the triangles (p, p + kSlopeSpan to the right, p +
 // kSlopeSpan down) of soil grid points; nullopt without enough of them.
-std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t columns) {
+std::optional<Tilt> ground_tilt(const std::vector<GridPoint>& grid, std::size_t columns) {
   thread_local std::vector<double> dz_dx;
   thread_local std::vector<double> dz_dy;
   dz_dx.clear();
@@ -195,9 +214,9 @@ std::optional<Tilt> ground_tilt(const std::vector<SoilPoint>& grid, std::size_t 
   const std::size_t rows = grid.size() / columns;
   for (std::size_t row = 0; row + kSlopeSpan < rows; row += kSlopeRowStep) {
     for (std::size_t col = 0; col + kSlopeSpan < columns; ++col) {
-      const SoilPoint& p = grid[row * columns + col];
-      const SoilPoint& right = grid[row * columns + col + kSlopeSpan];
-      const SoilPoint& below = grid[(row + kSlopeSpan) * columns + col];
+      const GridPoint& p = grid[row * columns + col];
+      const GridPoint& right = grid[row * columns + col + kSlopeSpan];
+      const GridPoint& below = grid[(row + kSlopeSpan) * columns + col];
       if (!std::isfinite(p.z) || !std::isfinite(right.z) || !std::isfinite(below.z)) continue;
       // dZ = dz_dx dX + dz_dy dY along both sides, by Cramer's rule.
       const double x1 = right.x - p.x, y1 = right.y - p.y, z1 = right.z - p.z;
@@ -240,9 +259,10 @@ double tool_level(const std::vector<SoilPoint>& points, const Tilt& tilt, double
     double weight = 0.0;
     double sum = 0.0;
     for (std::size_t i = 0; i < points.size(); ++i) {
-      if (std::abs(levels[i] - level) > threshold_mm) continue;
-      weight += points[i].weight;
-      sum += points[i].weight * levels[i];
+      // No branch: the points near the window's edges would mispredict one.
+      const double in_window = std::abs(levels[i] - level) <= threshold_mm ? 1.0 : 0.0;
+      weight += in_window * points[i].weight;
+      sum += in_window * points[i].weight * levels[i];
     }
     if (weight <= 0.0) break;
     const double moved = sum / weight - level;
@@ -362,7 +382,7 @@ class GroundPlaneEstimator final : public Transform {
         std::min(kBandPerNoise * depth_noise_mm(soil_mm, sampling.roi,
                                                 static_cast<float>(threshold_mm_ / kBandPerNoise)),
                  kMaxBandPerThreshold * threshold_mm_);
-    thread_local std::vector<SoilPoint> grid;  // every grid pixel; z NaN where no soil
+    thread_local std::vector<GridPoint> grid;  // every grid pixel
     thread_local std::vector<SoilPoint> points;
     grid.clear();
     points.clear();
@@ -371,7 +391,7 @@ class GroundPlaneEstimator final : public Transform {
       const double z = depth + camera.z_offset_mm;  // NaN where no soil
       const double x = pixel.x * z;
       const double y = pixel.y * z;
-      grid.push_back({x, y, z, 0.0, 0.0});
+      grid.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)});
       if (!std::isfinite(depth)) continue;
       const double weight = nearness(x, y, neighbourhood_mm_);
       if (weight < kNegligibleWeight) continue;

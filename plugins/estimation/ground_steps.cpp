@@ -62,6 +62,17 @@ double weakest_jump(const std::vector<double>& jumps) {
   return low > 0 ? low : high < 0 ? high : 0.0;
 }
 
+// The points of the ground, in floats, coordinate by coordinate.
+struct GroundPoints {
+  std::vector<float> x, y, level;
+
+  void clear() {
+    x.clear();
+    y.clear();
+    level.clear();
+  }
+};
+
 // The levels along the lines of one direction: per piece, running sums over its strips,
 // so that a side of any line is two look-ups.
 class Strips {
@@ -76,18 +87,21 @@ class Strips {
   int strips() const { return strips_; }
   int pieces() const { return pieces_; }
 
-  // The levels of `points` along lines in the direction (c, s): across them x c + y s.
-  void fill(std::span<const LevelPoint> points, double c, double s) {
-    sums_.assign(static_cast<std::size_t>(pieces_ * (strips_ + 1)), 0.0f);
-    counts_.assign(sums_.size(), 0.0f);
+  // The levels of `ground` along lines in the direction (c, s): across them x c + y s.
+  void fill(const GroundPoints& ground, double c, double s) {
+    const std::size_t cells = static_cast<std::size_t>(pieces_ * (strips_ + 1));
+    sums_.assign(cells + 1, 0.0f);  // and a last cell for the points beyond the strips
+    counts_.assign(cells + 1, 0.0f);
+    locate(ground, c, s, cells);
     // Points next to each other fall in one strip: adding the list's two halves in turn
     // keeps each sum from waiting for the one before.
-    const std::size_t half = points.size() / 2;
+    const std::size_t count = ground.level.size();
+    const std::size_t half = count / 2;
     for (std::size_t i = 0; i < half; ++i) {
-      add(points[i], c, s);
-      add(points[half + i], c, s);
+      add(cell_[i], ground.level[i]);
+      add(cell_[half + i], ground.level[half + i]);
     }
-    if (points.size() % 2 != 0) add(points.back(), c, s);
+    if (count % 2 != 0) add(cell_.back(), ground.level.back());
     // Every side's mean, from running sums over the strips; NaN without enough points,
     // and in the margins beyond the strips.
     means_.assign(static_cast<std::size_t>(pieces_ * row()), kNoSide);
@@ -112,15 +126,35 @@ class Strips {
   }
 
  private:
-  void add(const LevelPoint& point, double c, double s) {
+  // Each point's cell, piece * (strips + 1) + strip (strips 1-based: running sums start at
+  // 0), or `beyond` outside the strips; in floats, a vector of points at a time.
+  void locate(const GroundPoints& ground, double c, double s, std::size_t beyond) {
+    const auto across_x = static_cast<float>(c / kStripMm);
+    const auto across_y = static_cast<float>(s / kStripMm);
+    const auto along_x = static_cast<float>(-s / kPieceMm);
+    const auto along_y = static_cast<float>(c / kPieceMm);
     // Shifted to be positive, so that truncation is floor.
-    const double across = (point.x_mm * c + point.y_mm * s) / kStripMm + strips_ / 2 + 1;
-    const double along = (point.y_mm * c - point.x_mm * s) / kPieceMm + pieces_ / 2;
-    const int strip = static_cast<int>(across);  // 1-based: running sums start at 0
-    const int piece = static_cast<int>(along);
-    if (across < 1 || strip > strips_ || along < 0 || piece >= pieces_) return;
-    sums_[at(piece, strip)] += static_cast<float>(point.level_mm);
-    counts_[at(piece, strip)] += 1.0f;
+    const auto across_0 = static_cast<float>(strips_ / 2 + 1);
+    const auto along_0 = static_cast<float>(pieces_ / 2);
+    const int strips = strips_, pieces = pieces_, outside = static_cast<int>(beyond);
+    const std::size_t count = ground.level.size();
+    cell_.resize(count);
+    const float* const x = ground.x.data();
+    const float* const y = ground.y.data();
+    int* const cell = cell_.data();
+    for (std::size_t i = 0; i < count; ++i) {
+      const float across = x[i] * across_x + y[i] * across_y + across_0;
+      const float along = x[i] * along_x + y[i] * along_y + along_0;
+      const int strip = static_cast<int>(across);
+      const int piece = static_cast<int>(along);
+      const bool inside = (across >= 1) & (strip <= strips) & (along >= 0) & (piece < pieces);
+      cell[i] = inside ? piece * (strips + 1) + strip : outside;
+    }
+  }
+
+  void add(int cell, float level) {
+    sums_[static_cast<std::size_t>(cell)] += level;
+    counts_[static_cast<std::size_t>(cell)] += 1.0f;
   }
 
   float* writable_sides(int piece) {
@@ -139,6 +173,7 @@ class Strips {
 
   // In float: four lanes a vector where the lines are counted.
   std::vector<float> sums_, counts_, means_;
+  std::vector<int> cell_;  // per point
 };
 
 // Whether the tool point lies beyond the line at strip boundary `at` of the pieces' sides
@@ -159,7 +194,7 @@ bool tool_beyond(const std::vector<const float*>& rows, std::ptrdiff_t at, doubl
 }  // namespace
 
 std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, double min_height_mm) {
-  thread_local std::vector<LevelPoint> ground;
+  thread_local GroundPoints ground;
   thread_local std::vector<double> jumps, unevenness, differences;
   thread_local std::vector<const float*> rows;                         // per piece
   thread_local std::vector<int> counted, short_rising, short_falling;  // per line
@@ -170,7 +205,9 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
         !std::isfinite(point.y_mm)) {
       continue;  // not ground, or no point at all
     }
-    ground.push_back(point);
+    ground.x.push_back(static_cast<float>(point.x_mm));
+    ground.y.push_back(static_cast<float>(point.y_mm));
+    ground.level.push_back(static_cast<float>(point.level_mm));
     reach = std::max(reach, std::hypot(point.x_mm, point.y_mm));
   }
   thread_local Strips levels;  // its buffers kept from one frame to the next

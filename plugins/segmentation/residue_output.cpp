@@ -17,17 +17,6 @@ std::string size_text(const cv::Mat& image) {
   return std::to_string(image.cols) + "x" + std::to_string(image.rows);
 }
 
-// Sets what lies outside `area` (the rows above and below it, the columns either side).
-void fill_outside(cv::Mat& image, const cv::Rect& area, double value) {
-  for (const cv::Rect& band :
-       {cv::Rect(0, 0, image.cols, area.y),
-        cv::Rect(0, area.br().y, image.cols, image.rows - area.br().y),
-        cv::Rect(0, area.y, area.x, area.height),
-        cv::Rect(area.br().x, area.y, image.cols - area.br().x, area.height)}) {
-    if (!band.empty()) image(band).setTo(value);
-  }
-}
-
 }  // namespace
 
 std::vector<PortSpec> residue_inputs() {
@@ -169,11 +158,13 @@ void ResidueOutput::emit(Frame& frame, const cv::Rect& area, BitMask& residue,
   auto mask = masks_.acquire();
   auto soil = soil_depths_.acquire();
   soil->rig = depth.rig;  // the soil's depth is the depth's
+  const std::uint8_t* const mask_before = mask->values.data;
+  const std::uint8_t* const soil_before = soil->mm.data;
   reuse_or_create(mask->values, depth.mm.rows, depth.mm.cols, CV_8UC1);
   mask->segmented = area;
   reuse_or_create(soil->mm, depth.mm.rows, depth.mm.cols, CV_32FC1);
-  fill_outside(mask->values, area, ResidueMask::kUnknown);
-  fill_outside(soil->mm, area, std::numeric_limits<float>::quiet_NaN());
+  outside_.fill(mask->values, mask_before, area, ResidueMask::kUnknown);
+  outside_.fill(soil->mm, soil_before, area, std::numeric_limits<float>::quiet_NaN());
   cv::Mat mask_area = mask->values(area);
   cv::Mat soil_area = soil->mm(area);
 

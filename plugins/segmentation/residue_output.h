@@ -10,6 +10,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "bit_mask.h"
+#include "outside_fill.h"
 #include "residue_kernels.h"
 #include "roi/region_of_interest.h"
 #include "tilth/frame.h"
@@ -96,6 +97,7 @@ class ResidueOutput {
   const RegionOfInterest roi_;
   MessagePool<ResidueMask> masks_;
   MessagePool<DepthImage> soil_depths_;
+  OutsideFill outside_;
 };
 
 }  // namespace tilth::segmentation
