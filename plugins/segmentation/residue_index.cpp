@@ -71,9 +71,13 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
                          cv::Mat& index, std::array<double, kBins>& histogram) {
   constexpr int kLanes = 4;
   const float bins_per_unit = kBins / (range.high - range.low);
-  std::array<std::array<std::uint32_t, kBins>, kLanes> counts{};
+  std::array<std::array<std::uint32_t, kBins + 1>, kLanes> counts{};
   thread_local std::vector<float> blue, green, red;
+  thread_local std::vector<int> bins;
   for (auto* channel : {&blue, &green, &red}) channel->resize(summed.cols);
+  const int cols = summed.cols;  // read once: the bins' writes could alias it
+  bins.resize(cols);
+  int* const bin = bins.data();
   float* const b = blue.data();
   float* const g = green.data();
   float* const r = red.data();
@@ -87,12 +91,17 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
       r[col] = in[3 * col + 2];
     }
     for (int col = 0; col < summed.cols; ++col) out[col] = index_of<kIndex>(b[col], g[col], r[col]);
-    for (int col = 0; col < summed.cols; ++col) {
-      const float value = out[col];
-      if (skip[col] != 0 || std::isnan(value)) continue;
-      const int bin = static_cast<int>((value - range.low) * bins_per_unit);
-      ++counts[col % kLanes][std::clamp(bin, 0, kBins - 1)];
+    // Each pixel's bin, a vector at a time; kBins (counted, then left out) where the
+    // colour is untrusted or black.
+    for (int col = 0; col < cols; ++col) {
+      const bool black = out[col] != out[col];  // NaN
+      const float value = black ? range.low : out[col];
+      const float scaled = std::min(std::max((value - range.low) * bins_per_unit, 0.0f),
+                                    static_cast<float>(kBins - 1));
+      const int counted = (skip[col] == 0) & !black;
+      bin[col] = counted ? static_cast<int>(scaled) : kBins;
     }
+    for (int col = 0; col < cols; ++col) ++counts[col % kLanes][bin[col]];
   }
   for (const auto& lane : counts) {
     for (int bin = 0; bin < kBins; ++bin) histogram[bin] += lane[bin];
@@ -120,8 +129,8 @@ bool soil_quieter_than(const cv::Mat& index, const cv::Mat& untrusted, const Ind
     for (int col = 0; col + apart < index.cols; ++col) {
       const float a = value[col], b = value[col + apart];
       // NaN compares false: no colour, no pair.
-      const int soil =
-          (skip[col] | skip[col + apart]) == 0 && sign * a < soil_below && sign * b < soil_below;
+      const int soil = ((skip[col] | skip[col + apart]) == 0) & (sign * a < soil_below) &
+                       (sign * b < soil_below);
       pairs += soil;
       close += soil & (std::abs(b - a) <= within);
     }
