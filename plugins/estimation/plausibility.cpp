@@ -48,18 +48,18 @@ ColorEvidence evidence_in(const RegisteredColor& color, cv::Rect roi) {
   for (int row = roi.y; row < roi.y + roi.height; row += kSampleStep) {
     const auto* bgr = color.bgr.ptr<cv::Vec3b>(row);
     const auto* status = color.status.ptr<std::uint8_t>(row);
+    // Counted without a branch: the statuses of straw and soil alternate unpredictably.
     for (int col = roi.x; col < roi.x + roi.width; col += kSampleStep) {
-      if (status[col] == RegisteredColor::kNoDepth) continue;
-      ++seen.with_depth;
-      if (status[col] != RegisteredColor::kValid) continue;
+      const int valid = status[col] == RegisteredColor::kValid;
       const cv::Vec3b& pixel = bgr[col];
       const int low = std::min({pixel[0], pixel[1], pixel[2]});
       const int high = std::max({pixel[0], pixel[1], pixel[2]});
-      seen.clipped += (low >= kClippedWhite || high <= kClippedBlack) ? 1 : 0;
-      const int sum = pixel[0] + pixel[1] + pixel[2];
+      const int sum = valid * (pixel[0] + pixel[1] + pixel[2]);
+      seen.with_depth += status[col] != RegisteredColor::kNoDepth;
+      seen.clipped += valid & ((low >= kClippedWhite) | (high <= kClippedBlack));
       seen.channel_sum += sum;
       seen.channel_sum_squares += sum * sum;
-      ++seen.pixels;
+      seen.pixels += valid;
     }
   }
   return seen;
