@@ -384,19 +384,30 @@ class GroundPlaneEstimator final : public Transform {
                  kMaxBandPerThreshold * threshold_mm_);
     thread_local std::vector<GridPoint> grid;  // every grid pixel
     thread_local std::vector<SoilPoint> points;
-    grid.clear();
-    points.clear();
-    for (const GridPixel& pixel : sampling.grid) {
+    // The soil points first, without a branch (soil and residue alternate unpredictably),
+    // then their weights, leaving out those too far to count.
+    grid.resize(sampling.grid.size());
+    points.resize(sampling.grid.size());
+    std::size_t soil = 0;
+    for (std::size_t i = 0; i < sampling.grid.size(); ++i) {
+      const GridPixel& pixel = sampling.grid[i];
       const float depth = soil_mm.at<float>(pixel.row, pixel.col);
       const double z = depth + camera.z_offset_mm;  // NaN where no soil
       const double x = pixel.x * z;
       const double y = pixel.y * z;
-      grid.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)});
-      if (!std::isfinite(depth)) continue;
-      const double weight = nearness(x, y, neighbourhood_mm_);
-      if (weight < kNegligibleWeight) continue;
-      points.push_back({x, y, z, weight, nearness(x, y, tool_area_mm_)});
+      grid[i] = {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)};
+      points[soil] = {x, y, z, 0.0, 0.0};
+      soil += std::isfinite(depth) ? 1 : 0;
     }
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < soil; ++i) {
+      SoilPoint point = points[i];
+      point.weight = nearness(point.x, point.y, neighbourhood_mm_);
+      if (point.weight < kNegligibleWeight) continue;
+      point.vote = nearness(point.x, point.y, tool_area_mm_);
+      points[kept++] = point;
+    }
+    points.resize(kept);
     vote_near_the_tool(points);
     const std::optional<Tilt> tilt = ground_tilt(grid, sampling.grid_columns);
     if (!tilt || points.size() < 6) {
