@@ -199,7 +199,7 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
   thread_local std::vector<const float*> rows;                         // per piece
   thread_local std::vector<int> counted, short_rising, short_falling;  // per line
   ground.clear();
-  double reach = 0.0;
+  double reach_squared = 0.0;
   for (const LevelPoint& point : points) {
     if (!(std::abs(point.level_mm) <= kLevelBandMm) || !std::isfinite(point.x_mm) ||
         !std::isfinite(point.y_mm)) {
@@ -208,10 +208,10 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
     ground.x.push_back(static_cast<float>(point.x_mm));
     ground.y.push_back(static_cast<float>(point.y_mm));
     ground.level.push_back(static_cast<float>(point.level_mm));
-    reach = std::max(reach, std::hypot(point.x_mm, point.y_mm));
+    reach_squared = std::max(reach_squared, point.x_mm * point.x_mm + point.y_mm * point.y_mm);
   }
   thread_local Strips levels;  // its buffers kept from one frame to the next
-  levels.reach(reach);
+  levels.reach(std::sqrt(reach_squared));
   const int strips = levels.strips(), pieces = levels.pieces();
   std::optional<GroundStep> highest;
   for (int angle = 0; angle < kAngles; ++angle) {
