@@ -32,34 +32,19 @@ constexpr double kRoughness = 3.0;
 // Levels this far off the surface are not ground (residue the segmentation let through).
 constexpr double kLevelBandMm = 16.0;
 
-// The jump every piece of a line shows but one (there are four or more); 0 when they do
-// not agree on its sign.
-double weakest_jump(const std::vector<double>& jumps) {
-  // The two lowest and the two highest, in one pass.
-  double lowest = jumps[0], low = jumps[0], highest = jumps[0], high = jumps[0];
-  for (std::size_t i = 1; i < jumps.size(); ++i) {
-    const double jump = jumps[i];
-    if (i == 1) {
-      low = std::max(lowest, jump);
-      lowest = std::min(lowest, jump);
-      high = std::min(highest, jump);
-      highest = std::max(highest, jump);
-      continue;
-    }
-    if (jump < lowest) {
-      low = lowest;
-      lowest = jump;
-    } else if (jump < low) {
-      low = jump;
-    }
-    if (jump > highest) {
-      high = highest;
-      highest = jump;
-    } else if (jump > high) {
-      high = jump;
-    }
-  }
-  return low > 0 ? low : high < 0 ? high : 0.0;
+// Pieces of a line that may fail to show its step (residue the segmentation let through,
+// the noise of a side's mean): one in three, at least one.
+int spared_pieces(int pieces) { return std::max(1, pieces / 3); }
+
+// The jump every piece of a line shows but `spared`; 0 when they do not agree on its sign.
+// `jumps` is reordered.
+double weakest_jump(std::vector<double>& jumps, int spared) {
+  const auto lowest = jumps.begin() + spared;
+  std::nth_element(jumps.begin(), lowest, jumps.end());
+  if (*lowest > 0) return *lowest;
+  const auto highest = jumps.end() - 1 - spared;
+  std::nth_element(jumps.begin(), highest, jumps.end());
+  return *highest < 0 ? *highest : 0.0;
 }
 
 // The points of the ground, in floats, coordinate by coordinate.
@@ -240,7 +225,7 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
         rows.push_back(levels.sides(piece) + std::lround(shear * (piece - pieces / 2 + 0.5)));
       }
       // Per line: its pieces, and those short of least_height rising and falling. A step
-      // rises (or falls) by least_height in all pieces but one.
+      // rises (or falls) by least_height in all pieces but one in three (spared_pieces).
       counted.assign(edges, 0);
       short_rising.assign(edges, 0);
       short_falling.assign(edges, 0);
@@ -255,8 +240,9 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
         }
       }
       for (std::size_t edge = 0; edge < edges; ++edge) {
+        const int spared = spared_pieces(counted[edge]);
         if (counted[edge] < static_cast<int>(kMinPieces) ||
-            (short_rising[edge] > 1 && short_falling[edge] > 1)) {  // one piece is spared
+            (short_rising[edge] > spared && short_falling[edge] > spared)) {
           continue;
         }
         const auto at = static_cast<std::ptrdiff_t>(edge);
@@ -265,7 +251,7 @@ std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, doubl
           const double jump = sides[at] - sides[at - kStripsPerSide];
           if (!std::isnan(jump)) jumps.push_back(jump);
         }
-        const double height = weakest_jump(jumps);
+        const double height = weakest_jump(jumps, spared);
         if (std::abs(height) < least_height) continue;
         if (highest && std::abs(height) <= std::abs(highest->height_mm)) continue;
         // A step is flat on both sides; a wave of the relief across the line is not.
