@@ -5,10 +5,11 @@
 namespace tilth::modbus {
 
 void LatestMeasurement::update(std::uint64_t frame_id, const GroundDistance& distance,
-                               Clock::time_point arrived, std::chrono::milliseconds capture_age) {
+                               Clock::time_point arrived, Clock::duration capture_age) {
   // A held distance is as old as the frame it was measured in.
-  const auto held_for = std::chrono::milliseconds(
-      distance.held ? static_cast<std::int64_t>(std::max(distance.held_ms, 0.0)) : 0);
+  const auto held_for =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(
+          distance.held ? std::max(distance.held_ms, 0.0) : 0.0));
   Measurement measurement{frame_id,
                           distance.valid,
                           distance.valid && distance.held,
@@ -17,7 +18,7 @@ void LatestMeasurement::update(std::uint64_t frame_id, const GroundDistance& dis
                           distance.soil_fraction,
                           distance.confidence,
                           arrived,
-                          std::max(capture_age, std::chrono::milliseconds(0)) + held_for};
+                          std::max(capture_age, Clock::duration::zero()) + held_for};
   std::lock_guard lock(mutex_);
   measurement_ = measurement;
   last_frame_ = arrived;
@@ -45,8 +46,7 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
     values.age = std::chrono::milliseconds::max();  // never: saturates
     return values;
   }
-  const auto since_arrival =
-      std::chrono::duration_cast<std::chrono::milliseconds>(now - measurement_->arrived);
+  const auto since_arrival = now - measurement_->arrived;
   values.stale = since_arrival > stale_timeout_;
   values.valid = measurement_->valid && !values.stale && !last_frame_missing_;
   values.held = values.valid && measurement_->held;
@@ -55,7 +55,8 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
   values.soil_fraction = measurement_->soil_fraction;
   values.confidence = measurement_->confidence;
   values.frame_id = measurement_->frame_id;
-  values.age = measurement_->capture_age + std::max(since_arrival, std::chrono::milliseconds(0));
+  values.age = std::chrono::duration_cast<std::chrono::milliseconds>(
+      measurement_->capture_age + std::max(since_arrival, Clock::duration::zero()));
   return values;
 }
 

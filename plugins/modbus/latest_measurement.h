@@ -21,9 +21,10 @@ class LatestMeasurement {
   explicit LatestMeasurement(std::chrono::milliseconds stale_timeout)
       : stale_timeout_(stale_timeout) {}
 
-  // `capture_age`: how old the frame already was when it arrived here.
+  // `capture_age`: how old the frame already was when it arrived here. Ages are summed
+  // exactly and cut to whole milliseconds once, when a register shows them.
   void update(std::uint64_t frame_id, const GroundDistance& distance, Clock::time_point arrived,
-              std::chrono::milliseconds capture_age);
+              Clock::duration capture_age);
   // A frame arrived without a measurement: a stage upstream failed on it, or the
   // cameras delivered no images for it.
   void update_missing(Clock::time_point arrived);
@@ -43,7 +44,7 @@ class LatestMeasurement {
     double soil_fraction = 0.0;
     double confidence = 0.0;
     Clock::time_point arrived;
-    std::chrono::milliseconds capture_age{0};
+    Clock::duration capture_age{0};
   };
 
   const std::chrono::milliseconds stale_timeout_;

@@ -74,9 +74,9 @@ class ModbusOutput final : public Sink {
     }
     const auto& info = frame.info();
     // How old the frame already is, on the host clock the source stamped it with.
-    std::chrono::milliseconds capture_age{0};
+    LatestMeasurement::Clock::duration capture_age{0};
     if (info.host_timestamp_ns != 0) {
-      capture_age = std::chrono::duration_cast<std::chrono::milliseconds>(
+      capture_age = std::chrono::duration_cast<LatestMeasurement::Clock::duration>(
           std::chrono::system_clock::now().time_since_epoch() -
           std::chrono::nanoseconds(info.host_timestamp_ns));
     }

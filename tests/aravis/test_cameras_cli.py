@@ -24,6 +24,7 @@ import unittest
 SUPPORT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "support")
 sys.path.insert(0, SUPPORT)
 from fake_gige_camera import FakeCamera  # noqa: E402
+from processes import interrupt, start_logged  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 TEST_PLUGINS = os.environ["TILTH_TEST_PLUGIN_DIR"]
@@ -235,16 +236,16 @@ class FakeCamerasGraph(unittest.TestCase):
         graph = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs", "fake-cameras.json")
         with tempfile.TemporaryDirectory() as directory:
             rows_path = os.path.join(directory, "rows.csv")
-            log = open(os.path.join(directory, "stderr.txt"), "w+")
-            run = subprocess.Popen(
-                [TILTH, "run", graph, "--var", "depth_camera=" + DEPTH.address,
-                 "--var", "color_camera=" + COLOR.address, "--var", "log=" + rows_path],
-                stdout=subprocess.DEVNULL, stderr=log)
-            time.sleep(8)
-            run.send_signal(signal.SIGINT)
-            code = run.wait(timeout=30)
-            log.seek(0)
-            stderr = log.read()
+            with open(os.path.join(directory, "stderr.txt"), "w+") as log:
+                run = subprocess.Popen(
+                    [TILTH, "run", graph, "--var", "depth_camera=" + DEPTH.address,
+                     "--var", "color_camera=" + COLOR.address, "--var", "log=" + rows_path],
+                    stdout=subprocess.DEVNULL, stderr=log)
+                time.sleep(8)
+                run.send_signal(signal.SIGINT)
+                code = run.wait(timeout=30)
+                log.seek(0)
+                stderr = log.read()
             self.assertEqual(code, 0, stderr)
             with open(rows_path, newline="") as f:
                 rows = list(csv.DictReader(f))
@@ -269,6 +270,52 @@ class FakeCamerasGraph(unittest.TestCase):
                     if line.startswith("chain/register ")]
         self.assertEqual(len(register), 1, stderr)
         self.assertEqual(register[0][-2], "0", stderr)  # errors
+
+
+class FakeCamerasGraphOnAScene(unittest.TestCase):
+    """graphs/fake-cameras.json on two simulators that show a scene rendered by `tilth
+    simulate` (case_c, 518 mm, with its colour as a BayerRG8 mosaic): the distance that
+    comes out of the live cameras is the scene's."""
+
+    def test_measures_the_scene_the_cameras_show(self):
+        graph = os.path.join(os.environ["TILTH_SOURCE_DIR"], "graphs", "fake-cameras.json")
+        with tempfile.TemporaryDirectory() as directory:
+            scene = os.path.join(directory, "scene")
+            subprocess.run([TILTH, "simulate", scene, "--preset", "case_c", "--frames", "1",
+                            "--color-format", "bayer_rggb8"], check=True, timeout=60,
+                           stdout=subprocess.DEVNULL)
+            with open(os.path.join(scene, "frames.csv"), newline="") as f:
+                truth_mm = float(next(csv.DictReader(f))["ground_truth_mm"])
+            depth = FakeCamera("127.0.0.23", "TILTH23",
+                               image=os.path.join(scene, "depth", "000000.png"))
+            color = FakeCamera("127.0.0.24", "TILTH24",
+                               image=os.path.join(scene, "color", "000000.png"))
+            rows_path = os.path.join(directory, "rows.csv")
+            log_path = os.path.join(directory, "stderr.txt")
+            run = None
+            try:
+                depth.start()
+                color.start()
+                run = start_logged(
+                    [TILTH, "run", graph, "--var", "depth_camera=" + depth.address,
+                     "--var", "color_camera=" + color.address, "--var", "log=" + rows_path],
+                    log_path)
+                time.sleep(6)
+            finally:
+                interrupt(run)
+                depth.kill()
+                color.kill()
+            with open(log_path) as log:
+                stderr = log.read()
+            self.assertEqual(run.returncode, 0, stderr)
+            with open(rows_path, newline="") as f:
+                measured = list(csv.DictReader(f))
+        self.assertGreaterEqual(len(measured), 60, stderr)
+        self.assertTrue(all(row["valid"] == "1" for row in measured), measured[:5])
+        # Every pair shows the same frame: within the static scenes' bound (docs/accuracy.md).
+        for row in measured:
+            self.assertAlmostEqual(float(row["distance_mm"]), truth_mm, delta=0.5)
+
 
 if __name__ == "__main__":
     unittest.main()

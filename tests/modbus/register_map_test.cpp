@@ -13,6 +13,7 @@
 namespace tilth::modbus {
 namespace {
 
+using std::chrono::microseconds;
 using std::chrono::milliseconds;
 
 RegisterValues valid_distance(double distance_mm) {
@@ -190,6 +191,14 @@ TEST_F(LatestMeasurementTest, ValidUntilTheStaleTimeoutThenStale) {
   EXPECT_EQ(block[kStatus], kStale);
   EXPECT_EQ(block[kDistanceHundredthsMm + 1], 0);
   EXPECT_EQ(block[kAgeMs], 213);
+}
+
+// Capture to arrival 12.6 ms, arrival to the reading 0.6 ms: 13.2 ms, shown as 13. Each part
+// cut to whole milliseconds first would show 12, a frame younger than it is.
+TEST_F(LatestMeasurementTest, TheAgeIsCutToWholeMillisecondsOnceNotPartByPart) {
+  latest_.update(7, measured(518.23, true), t0_, microseconds(12600));
+  EXPECT_EQ(latest_.values_at(t0_ + microseconds(600)).age, milliseconds(13));
+  EXPECT_EQ(latest_.values_at(t0_ + microseconds(399)).age, milliseconds(12));
 }
 
 TEST_F(LatestMeasurementTest, AFrameWithoutMeasurementIsAPipelineError) {

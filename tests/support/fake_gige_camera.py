@@ -1,7 +1,9 @@
 """Aravis's GigE Vision camera simulator (arv-fake-gv-camera-0.8) on a loopback address
-of its own, started and killed by its pid. With trigger_checks_hz, the simulator is
-tilth-fake-gige-camera (its path in TILTH_FAKE_CAMERA), which looks for a software
-trigger that many times a second instead of arv-fake-gv-camera's 25."""
+of its own, started and killed by its pid. With trigger_checks_hz or image, the
+simulator is tilth-fake-gige-camera (its path in TILTH_FAKE_CAMERA), which looks for a
+software trigger that many times a second instead of arv-fake-gv-camera's 25, and shows
+that PNG (a rendered scene: a recording's depth or colour frame) instead of its test
+pattern."""
 import os
 import socket
 import struct
@@ -18,9 +20,9 @@ def udp_bound(address, port):
 
 
 class FakeCamera:
-    def __init__(self, address, serial, trigger_checks_hz=None):
+    def __init__(self, address, serial, trigger_checks_hz=None, image=None):
         self.address, self.serial, self.process = address, serial, None
-        self.trigger_checks_hz = trigger_checks_hz
+        self.trigger_checks_hz, self.image = trigger_checks_hz, image
         shown = subprocess.run(["ip", "-o", "addr", "show", "dev", "lo"], capture_output=True,
                                text=True, check=True).stdout
         if " inet %s/" % address not in shown:
@@ -30,9 +32,12 @@ class FakeCamera:
         assert not udp_bound(self.address, GVCP_PORT), "a device already listens on " + self.address
         # At a higher priority than the tests: the simulator plays a camera, which has a
         # processor of its own.
-        if self.trigger_checks_hz:
-            simulator = [os.environ["TILTH_FAKE_CAMERA"], self.address, self.serial,
-                         str(self.trigger_checks_hz)]
+        if self.trigger_checks_hz or self.image:
+            simulator = [os.environ["TILTH_FAKE_CAMERA"], self.address, self.serial]
+            if self.trigger_checks_hz:
+                simulator += ["--trigger-checks-hz", str(self.trigger_checks_hz)]
+            if self.image:
+                simulator += ["--image", self.image]
         else:
             simulator = ["arv-fake-gv-camera-0.8", "-i", self.address, "-s", self.serial]
         self.process = subprocess.Popen(["nice", "-n", "-10"] + simulator,
