@@ -8,10 +8,19 @@
 // pixel format the client sets: a 16-bit PNG as Mono16, an 8-bit grey one as Mono8 or
 // as the Bayer mosaic it already is, a colour one as Mono8 or mosaicked to the Bayer
 // pattern asked for. Runs until SIGTERM or SIGINT.
+//
+// Aravis's simulator waits for its next frame, or its next look for a trigger, in g_poll
+// with a timeout in whole milliseconds, and spins with a timeout of 0 through the last
+// millisecond: looking for a trigger every millisecond, it spins a whole core. A camera
+// spends no processor of the host's waiting, so this program's g_poll, which the
+// simulator's thread reaches before GLib's, sleeps that last part instead.
+#include <poll.h>
+#include <pthread.h>
 #include <signal.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +35,11 @@
 #include <opencv2/imgproc.hpp>
 
 namespace {
+
+// Set once the simulator runs; its thread is the only one besides main's, which waits
+// for a signal.
+std::atomic<ArvFakeCamera*> waiting_camera{nullptr};
+const pthread_t main_thread = pthread_self();
 
 // The Bayer patterns by the colour of their top-left 2x2 cell, in BGR channel indices.
 const std::map<ArvPixelFormat, std::array<int, 4>> kBayerCells = {
@@ -111,6 +125,23 @@ void show_scene(ArvBuffer* buffer, void* data, guint32, guint32, ArvPixelFormat 
   }
 }
 
+}  // namespace
+
+// GPollFD is struct pollfd on Linux (GLib's g_poll is poll there).
+extern "C" gint g_poll(GPollFD* fds, guint nfds, gint timeout) {
+  auto* const polled = reinterpret_cast<pollfd*>(fds);
+  ArvFakeCamera* const camera = waiting_camera.load();
+  if (timeout != 0 || camera == nullptr || pthread_equal(pthread_self(), main_thread)) {
+    return poll(polled, nfds, timeout);
+  }
+  const guint64 wait_us = arv_fake_camera_get_sleep_time_for_next_frame(camera, nullptr);
+  const timespec wait{static_cast<time_t>(wait_us / 1000000),
+                      static_cast<long>(wait_us % 1000000 * 1000)};
+  return ppoll(polled, nfds, &wait, nullptr);
+}
+
+namespace {
+
 int usage() {
   std::fprintf(stderr,
                "usage: tilth-fake-gige-camera ADDRESS SERIAL [--trigger-checks-hz HZ] "
@@ -169,6 +200,7 @@ int main(int argc, char** argv) {
   }
   ArvFakeCamera* camera = arv_gv_fake_camera_get_fake_camera(simulator);
   if (checks_hz > 0.0) arv_fake_camera_set_trigger_frequency(camera, checks_hz);
+  waiting_camera = camera;
   if (scene) {
     const auto width = static_cast<guint32>(scene->width());
     const auto height = static_cast<guint32>(scene->height());
