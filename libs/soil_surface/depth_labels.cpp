@@ -45,7 +45,7 @@ DepthLabelOptions checked(const DepthLabelOptions& options) {
 
 DepthLabels::DepthLabels(const DepthLabelOptions& options)
     : options_(checked(options)),
-      surface_(kSurfaceHeightMm, kSurfaceSigmaPx, options.envelope_px),
+      surface_(kSurfaceHeightMm, kSurfaceHeightMm, kSurfaceSigmaPx, options.envelope_px),
       edge_(cv::getStructuringElement(cv::MORPH_RECT,
                                       {2 * options.edge_px + 1, 2 * options.edge_px + 1})) {}
 

@@ -47,7 +47,9 @@ RegisterValues LatestMeasurement::values_at(Clock::time_point now) const {
     return values;
   }
   const auto since_arrival = now - measurement_->arrived;
-  values.stale = since_arrival > stale_timeout_;
+  // In whole milliseconds, as the age shows it: a stale block's age is past the timeout.
+  values.stale =
+      std::chrono::duration_cast<std::chrono::milliseconds>(since_arrival) > stale_timeout_;
   values.valid = measurement_->valid && !values.stale && !last_frame_missing_;
   values.held = values.valid && measurement_->held;
   values.cause = measurement_->cause;

@@ -23,9 +23,8 @@ namespace {
 class DepthAided final : public Transform {
  public:
   explicit DepthAided(const StageContext& context)
-      : height_mm_(context.params.number("height_mm")),
-        surface_(height_mm_, context.params.number("surface_px"),
-                 context.params.number("envelope_px")),
+      : surface_(context.params.number("height_mm"), context.params.number("max_height_mm"),
+                 context.params.number("surface_px"), context.params.number("envelope_px")),
         output_(context.params) {}
 
   void process(Frame& frame) override {
@@ -37,15 +36,14 @@ class DepthAided final : public Transform {
 
     thread_local cv::Mat missing, height, residue, unknown;
     mark_missing_depth(depth_mm, missing);
-    surface_.heights(depth_mm, missing, ~missing, height);
-    cv::compare(height, height_mm_, residue, cv::CMP_GT);  // NaN: no
+    const double residue_mm = surface_.heights(depth_mm, missing, ~missing, height);
+    cv::compare(height, residue_mm, residue, cv::CMP_GT);  // NaN: no
     cv::compare(height, height, unknown, cv::CMP_NE);      // NaN: no surface near
     cv::bitwise_or(unknown, missing, unknown);
     output_.emit(frame, area, residue, unknown, unknown, depth_mm);
   }
 
  private:
-  const double height_mm_;
   const SoilSurface surface_;
   ResidueOutput output_;
 };
@@ -58,7 +56,7 @@ StageDescriptor describe_depth_aided() {
   d.summary = "residue mask from the height above a robust soil surface (depth only)";
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
-  d.params = {height_mm_param(),   surface_px_param(),    envelope_px_param(),
+  d.params = {height_mm_param(),   max_height_mm_param(), surface_px_param(), envelope_px_param(),
               dilation_px_param(), segmented_roi_param(), speckle_px_param(1)};
   d.concurrency = Concurrency::kParallel;
   d.create = factory<DepthAided>();

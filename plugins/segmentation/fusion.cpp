@@ -34,9 +34,8 @@ class Fusion final : public Transform {
                static_cast<int>(context.params.integer("smoothing_px")),
                static_cast<int>(context.params.integer("max_smoothing_px"))),
         min_value_(static_cast<int>(context.params.integer("min_value"))),
-        height_mm_(context.params.number("height_mm")),
-        surface_(height_mm_, context.params.number("surface_px"),
-                 context.params.number("envelope_px")),
+        surface_(context.params.number("height_mm"), context.params.number("max_height_mm"),
+                 context.params.number("surface_px"), context.params.number("envelope_px")),
         output_(context.params),
         notice_(context.log) {}
 
@@ -49,8 +48,8 @@ class Fusion final : public Transform {
     cv::bitwise_or(by_color, in.unknown, soil_color);
     cv::bitwise_not(soil_color, soil_color);
 
-    surface_.heights(in.depth_mm, in.missing, soil_color, height);
-    cv::compare(height, height_mm_, by_height, cv::CMP_GT);  // NaN: no
+    const double residue_mm = surface_.heights(in.depth_mm, in.missing, soil_color, height);
+    cv::compare(height, residue_mm, by_height, cv::CMP_GT);  // NaN: no
     cv::bitwise_or(by_color, by_height, by_color);
     cv::compare(height, height, unknown, cv::CMP_NE);  // NaN: no surface, no height cue
     cv::bitwise_or(unknown, in.unknown, unknown);
@@ -60,7 +59,6 @@ class Fusion final : public Transform {
  private:
   const ResidueIndex index_;
   const int min_value_;
-  const double height_mm_;
   const SoilSurface surface_;
   ResidueOutput output_;
   OneMaterialNotice notice_;
@@ -75,9 +73,9 @@ StageDescriptor describe_fusion() {
   d.inputs = residue_inputs();
   d.outputs = residue_outputs();
   d.params = {
-      color_index_param(), smoothing_px_param(), max_smoothing_px_param(), height_mm_param(),
-      surface_px_param(),  envelope_px_param(),  dilation_px_param(),      segmented_roi_param(),
-      speckle_px_param(1), min_value_param(),
+      color_index_param(),   smoothing_px_param(), max_smoothing_px_param(), height_mm_param(),
+      max_height_mm_param(), surface_px_param(),   envelope_px_param(),      dilation_px_param(),
+      segmented_roi_param(), speckle_px_param(1),  min_value_param(),
   };
   d.concurrency = Concurrency::kParallel;
   d.create = factory<Fusion>();

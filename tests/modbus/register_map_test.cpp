@@ -201,6 +201,18 @@ TEST_F(LatestMeasurementTest, TheAgeIsCutToWholeMillisecondsOnceNotPartByPart) {
   EXPECT_EQ(latest_.values_at(t0_ + microseconds(399)).age, milliseconds(12));
 }
 
+// Stale once the whole milliseconds since arrival pass the timeout (200 ms), so that a
+// stale block's age always reads past it.
+TEST_F(LatestMeasurementTest, StaleOnlyOnceTheWholeMillisecondsPassTheTimeout) {
+  latest_.update(7, measured(518.23, true), t0_, milliseconds(0));
+  const RegisterValues last_valid = latest_.values_at(t0_ + microseconds(200900));
+  EXPECT_FALSE(last_valid.stale);
+  EXPECT_EQ(last_valid.age, milliseconds(200));
+  const RegisterValues stale = latest_.values_at(t0_ + microseconds(201000));
+  EXPECT_TRUE(stale.stale);
+  EXPECT_EQ(stale.age, milliseconds(201));
+}
+
 TEST_F(LatestMeasurementTest, AFrameWithoutMeasurementIsAPipelineError) {
   latest_.update(1, measured(500.0, true), t0_, milliseconds(0));
   latest_.update_missing(t0_ + milliseconds(150));
