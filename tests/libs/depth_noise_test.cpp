@@ -8,24 +8,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "synthetic_ground.h"
+
 namespace tilth {
 namespace {
 
 const cv::Rect kRegion(160, 120, 320, 240);  // the middle half of 640x480
 
-// A plane 518 mm away, tilted 5 degrees along the rows (0.09 mm a pixel at about 1.1 mm
-// a pixel), with Gaussian noise.
 cv::Mat noisy_plane(double sigma_mm) {
-  cv::Mat depth(480, 640, CV_32FC1);
-  for (int v = 0; v < depth.rows; ++v) {
-    for (int u = 0; u < depth.cols; ++u) {
-      depth.at<float>(v, u) = static_cast<float>(518.0 + 0.09 * (u - 320));
-    }
-  }
-  cv::Mat noise(depth.size(), CV_32FC1);
-  cv::RNG rng(5);
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma_mm);
-  return depth + noise;
+  return testing::noisy_tilted_plane({640, 480}, sigma_mm, 5);
 }
 
 // The estimate's own spread: the median of about 19 000 differences is within 1.3 % (two

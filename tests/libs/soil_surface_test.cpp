@@ -7,25 +7,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "synthetic_ground.h"
+
 namespace tilth::segmentation {
 namespace {
 
-// The chain's region, 320x240, of a plane 518 mm away tilted 5 degrees along the rows.
-cv::Mat noisy_plane(double sigma_mm) {
-  cv::Mat depth(240, 320, CV_32FC1);
-  for (int v = 0; v < depth.rows; ++v) {
-    for (int u = 0; u < depth.cols; ++u) {
-      depth.at<float>(v, u) = static_cast<float>(518.0 + 0.09 * (u - 160));
-    }
-  }
-  cv::Mat noise(depth.size(), CV_32FC1);
-  cv::RNG rng(7);
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma_mm);
-  return depth + noise;
-}
-
 double residue_height_mm(const SoilSurface& surface, double sigma_mm) {
-  const cv::Mat depth = noisy_plane(sigma_mm);
+  // The chain's region, 320x240.
+  const cv::Mat depth = testing::noisy_tilted_plane({320, 240}, sigma_mm, 7);
   const cv::Mat missing(depth.size(), CV_8UC1, cv::Scalar(0));
   const cv::Mat candidates(depth.size(), CV_8UC1, cv::Scalar(255));
   cv::Mat height;

@@ -60,6 +60,15 @@ json exact(json params = json::object()) {
   return params;
 }
 
+// depth_aided's residue on `frame` (exact `params`): how many straw pixels it holds, and
+// how many soil pixels.
+std::pair<int, int> straws_found(const PaintedFrame& frame, const json& params) {
+  const Segmented out = segment(describe_depth_aided(), exact(params), frame);
+  const cv::Mat residue = out.mask == ResidueMask::kResidue;
+  const cv::Mat truth = straw_truth();
+  return {cv::countNonZero(residue & truth), cv::countNonZero(residue & ~truth)};
+}
+
 TEST(DepthAided, FindsSoilColouredStrawOnTiltedGround) {
   PaintedFrame frame = tilted_ground(kSoil);
   for (const auto& straw : kStraws) lay_straw(frame, straw, kWetStraw, 5.0);
@@ -83,15 +92,9 @@ TEST(DepthAided, FindsSoilColouredStrawOnTiltedGround) {
 TEST(DepthAided, LocalSurfaceFollowsReliefThatAPlaneCannot) {
   PaintedFrame frame = tilted_ground(kSoil, 2.5);
   for (const auto& straw : kStraws) lay_straw(frame, straw, kWetStraw, 6.0);
-  const cv::Mat truth = straw_truth();
-  const auto found = [&](const json& params) {
-    const Segmented out = segment(describe_depth_aided(), exact(params), frame);
-    const cv::Mat residue = out.mask == ResidueMask::kResidue;
-    return std::pair{cv::countNonZero(residue & truth), cv::countNonZero(residue & ~truth)};
-  };
-  const auto [local_hits, local_false] = found(json::object());
-  const auto [plane_hits, plane_false] = found({{"surface_px", 0}});
-  const int straw_pixels = cv::countNonZero(truth);
+  const auto [local_hits, local_false] = straws_found(frame, json::object());
+  const auto [plane_hits, plane_false] = straws_found(frame, {{"surface_px", 0}});
+  const int straw_pixels = cv::countNonZero(straw_truth());
   const int soil_pixels = kSize.area() - straw_pixels;
   EXPECT_GE(local_hits, straw_pixels - 4 * static_cast<int>(kStraws.size()));
   EXPECT_EQ(local_false, 0);
@@ -106,15 +109,9 @@ TEST(DepthAided, LocalSurfaceFollowsReliefThatAPlaneCannot) {
 TEST(DepthAided, NoisyDepthRaisesTheResidueHeight) {
   PaintedFrame frame = tilted_ground(kSoil, 0.0, 7.0);
   for (const auto& straw : kStraws) lay_straw(frame, straw, kWetStraw, 8.0);
-  const cv::Mat truth = straw_truth();
-  const auto found = [&](const json& params) {
-    const Segmented out = segment(describe_depth_aided(), exact(params), frame);
-    const cv::Mat residue = out.mask == ResidueMask::kResidue;
-    return std::pair{cv::countNonZero(residue & truth), cv::countNonZero(residue & ~truth)};
-  };
-  const auto [risen_hits, risen_false] = found(json::object());
-  const auto [fixed_hits, fixed_false] = found({{"max_height_mm", 3}});
-  const int straw_pixels = cv::countNonZero(truth);
+  const auto [risen_hits, risen_false] = straws_found(frame, json::object());
+  const auto [fixed_hits, fixed_false] = straws_found(frame, {{"max_height_mm", 3}});
+  const int straw_pixels = cv::countNonZero(straw_truth());
   const int soil_pixels = kSize.area() - straw_pixels;
   EXPECT_GT(fixed_false, 0.2 * soil_pixels);
   EXPECT_LT(risen_false, 0.5 * fixed_false);

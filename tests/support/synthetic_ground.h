@@ -29,6 +29,22 @@ struct GroundScene {
 
 inline double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
+// A depth image of `size` (CV_32FC1, mm) of a plane 518 mm away at the middle column,
+// tilted 5 degrees along the rows (0.09 mm a pixel at about 1.1 mm a pixel), with
+// Gaussian noise of `sigma_mm`: no camera model, for the tests of noise measures.
+inline cv::Mat noisy_tilted_plane(cv::Size size, double sigma_mm, std::uint64_t seed) {
+  cv::Mat depth(size, CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      depth.at<float>(v, u) = static_cast<float>(518.0 + 0.09 * (u - size.width / 2));
+    }
+  }
+  cv::Mat noise(depth.size(), CV_32FC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma_mm);
+  return depth + noise;
+}
+
 // The plane's mounting-surface distance (Z - z_offset) at camera-frame (X, Y).
 inline double plane_distance_at(const GroundScene& scene, double x_mm, double y_mm) {
   return scene.distance_mm + std::tan(radians(scene.tilt_y_deg)) * x_mm +
