@@ -187,7 +187,9 @@ class Chain {
   std::array<Packet, 1> distance_;
 };
 
-void run(benchmark::State& state, const char* color_format, Chain::Step step) {
+// `idle`: how long the core waits, untimed, before each frame.
+void run(benchmark::State& state, const char* color_format, Chain::Step step,
+         std::chrono::microseconds idle = std::chrono::microseconds(0)) {
   cv::setNumThreads(0);  // one core: OpenCV's own threads (demosaicing, cvtColor) off too
   Chain chain(color_format);
   for (int warm_up = 0; warm_up < 3; ++warm_up) chain.run(Chain::kWhole);
@@ -206,7 +208,14 @@ void run(benchmark::State& state, const char* color_format, Chain::Step step) {
   cv::MatAllocator* const previous = cv::Mat::getDefaultAllocator();
   cv::Mat::setDefaultAllocator(&counting);
   const std::int64_t before = allocations.load();
-  for (auto _ : state) chain.run(step);
+  for (auto _ : state) {
+    if (idle.count() > 0) {
+      state.PauseTiming();
+      std::this_thread::sleep_for(idle);
+      state.ResumeTiming();
+    }
+    chain.run(step);
+  }
   const std::int64_t counted = allocations.load() - before;
   cv::Mat::setDefaultAllocator(previous);
 
@@ -221,15 +230,7 @@ void chain(benchmark::State& state, const char* color_format) {
 // The whole chain at the cameras' pace: the core idles for a frame period between two
 // frames, as under `tilth run` at 30 frames/s, and the frame finds colder caches.
 void chain_at_30fps(benchmark::State& state, const char* color_format) {
-  cv::setNumThreads(0);
-  Chain chain(color_format);
-  for (int warm_up = 0; warm_up < 3; ++warm_up) chain.run(Chain::kWhole);
-  for (auto _ : state) {
-    state.PauseTiming();
-    std::this_thread::sleep_for(std::chrono::microseconds(33333));
-    state.ResumeTiming();
-    chain.run(Chain::kWhole);
-  }
+  run(state, color_format, Chain::kWhole, std::chrono::microseconds(33333));
 }
 void project(benchmark::State& state, const char* color_format) {
   run(state, color_format, Chain::kProject);

@@ -38,11 +38,10 @@ struct GroundStep {
 // The highest step among `points`, or nullopt. A step is a straight line, in any
 // direction, across which the level jumps in every 40 mm piece of it but one in three
 // (at least one; at least four pieces), by at least min_height_mm and three times the
-// median jump across the
-// lines that way (on rough ground a step must stand out of the roughness), with the level
-// on either side flat within 35 % of the jump over 16 mm. Relief, clods and residue the
-// segmentation let through jump in a few pieces, and a wave of the relief is not flat on
-// either side of its slope.
+// median jump across the lines that way (on rough ground a step must stand out of the
+// roughness), with the level on either side flat within 35 % of the jump over 16 mm. Relief, clods
+// and residue the segmentation let through jump in a few pieces, and a wave of the relief is not
+// flat on either side of its slope.
 std::optional<GroundStep> highest_step(std::span<const LevelPoint> points, double min_height_mm);
 
 }  // namespace tilth::estimation
