@@ -25,6 +25,9 @@ namespace tilth::segmentation {
 namespace {
 
 constexpr int kSampleStepPx = 8;
+// The plane beside the envelope only bounds how high the envelope may ride, within a
+// residue height: a quarter of the points will do, at a quarter of the cost.
+constexpr int kBesideEnvelopeStepPx = 16;
 constexpr int kHypotheses = 200;
 constexpr std::size_t kScoreStep = 2;  // hypotheses are scored on every second point
 constexpr int kRefinements = 5;
@@ -124,17 +127,17 @@ bool supports(float depth, std::uint8_t missing, std::uint8_t candidate) {
   return (candidate != 0) & (missing == 0) & (depth > 0);  // `&`: no branch, vectorised
 }
 
-// The RANSAC plane through the depths of every kSampleStepPx-th supported pixel, unless
+// The RANSAC plane through the depths of every `step`-th supported pixel, unless
 // too few are supported.
 std::optional<Plane> farthest_plane(const cv::Mat& depth, const cv::Mat& missing,
-                                    const cv::Mat& candidates) {
+                                    const cv::Mat& candidates, int step) {
   thread_local std::vector<Point> points;
   points.clear();
-  for (int row = kSampleStepPx / 2; row < depth.rows; row += kSampleStepPx) {
+  for (int row = step / 2; row < depth.rows; row += step) {
     const auto* d = depth.ptr<float>(row);
     const auto* none = missing.ptr<std::uint8_t>(row);
     const auto* candidate = candidates.ptr<std::uint8_t>(row);
-    for (int col = kSampleStepPx / 2; col < depth.cols; col += kSampleStepPx) {
+    for (int col = step / 2; col < depth.cols; col += step) {
       if (supports(d[col], none[col], candidate[col]))
         points.push_back({double(col), double(row), d[col]});
     }
@@ -246,6 +249,29 @@ void heights_above(const cv::Mat& half, const cv::Mat& depth, const cv::Mat& mis
   }
 }
 
+// Each pixel's height above `plane`; NaN where the pixel has no depth, and everywhere
+// without a plane.
+void heights_above(const std::optional<Plane>& plane, const cv::Mat& depth, const cv::Mat& missing,
+                   cv::Mat& height) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  height.create(depth.size(), CV_32FC1);
+  if (!plane) {
+    height.setTo(kNaN);
+    return;
+  }
+  for (int row = 0; row < depth.rows; ++row) {
+    const auto* d = depth.ptr<float>(row);
+    const auto* none = missing.ptr<std::uint8_t>(row);
+    auto* out = height.ptr<float>(row);
+    const auto start = static_cast<float>(plane->at(0.0, row));
+    const auto step = static_cast<float>(plane->a);
+    for (int col = 0; col < depth.cols; ++col) {
+      const float at = start + step * static_cast<float>(col);
+      out[col] = pick((none[col] == 0) & (d[col] > 0), at - d[col], kNaN);
+    }
+  }
+}
+
 // The envelope's window on the half-resolution grid: odd, about envelope_px / 2 wide.
 cv::Mat envelope_window(double envelope_px) {
   if (envelope_px <= 0) return {};
@@ -271,6 +297,18 @@ double SoilSurface::residue_height_mm(const cv::Mat& depth_mm) const {
 
 double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
                             const cv::Mat& candidates, cv::Mat& height_mm) const {
+  return heights(depth_mm, missing, candidates, height_mm, nullptr);
+}
+
+double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
+                            const cv::Mat& candidates, cv::Mat& height_mm,
+                            cv::Mat& plane_height_mm) const {
+  return heights(depth_mm, missing, candidates, height_mm, &plane_height_mm);
+}
+
+double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
+                            const cv::Mat& candidates, cv::Mat& height_mm,
+                            cv::Mat* plane_height_mm) const {
   const double residue_mm = residue_height_mm(depth_mm);
   thread_local cv::Mat zeroed, depth, supported, surface;
   // A 3x3 median: a third of the ToF noise, and single dropouts (0 here) do not count;
@@ -285,15 +323,20 @@ double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
   cv::medianBlur(zeroed, depth, 3);
   half_support(depth, missing, candidates, supported);
 
-  if (!envelope_window_.empty()) {
-    envelope(supported, envelope_window_, surface);
-  } else {
-    const std::optional<Plane> plane = farthest_plane(depth, missing, candidates);
-    if (!plane) {
-      height_mm.create(depth_mm.size(), CV_32FC1);
-      height_mm.setTo(std::numeric_limits<float>::quiet_NaN());
-      return residue_mm;
-    }
+  const bool from_plane = envelope_window_.empty();
+  std::optional<Plane> plane;
+  if (from_plane) {
+    plane = farthest_plane(depth, missing, candidates, kSampleStepPx);
+  } else if (plane_height_mm != nullptr) {
+    plane = farthest_plane(depth, missing, candidates, kBesideEnvelopeStepPx);
+  }
+  if (plane_height_mm != nullptr) heights_above(plane, depth, missing, *plane_height_mm);
+  if (from_plane && !plane) {
+    height_mm.create(depth_mm.size(), CV_32FC1);
+    height_mm.setTo(std::numeric_limits<float>::quiet_NaN());
+    return residue_mm;
+  }
+  if (from_plane) {
     surface.create(supported.size(), CV_32FC1);
     for (int row = 0; row < surface.rows; ++row) {
       auto* s = surface.ptr<float>(row);
@@ -301,6 +344,8 @@ double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
         s[col] = static_cast<float>(plane->at(2 * col + 0.5, 2 * row + 0.5));
       }
     }
+  } else {
+    envelope(supported, envelope_window_, surface);
   }
   if (surface_px_ > 0) follow_relief(supported, residue_mm, surface_px_, surface);
   heights_above(surface, depth, missing, height_mm);

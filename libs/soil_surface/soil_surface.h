@@ -27,11 +27,19 @@ class SoilSurface {
   // Returns the height above which this frame's pixels are residue.
   double heights(const cv::Mat& depth_mm, const cv::Mat& missing, const cv::Mat& candidates,
                  cv::Mat& height_mm) const;
+  // The same, and in `plane_height_mm` each pixel's height above the plane through the
+  // farthest depths (the start without an envelope), which a pile's lowest layer does not
+  // reach down to the way the envelope does: NaN where the pixel has no depth, and
+  // everywhere when no plane could be found.
+  double heights(const cv::Mat& depth_mm, const cv::Mat& missing, const cv::Mat& candidates,
+                 cv::Mat& height_mm, cv::Mat& plane_height_mm) const;
 
  private:
   // `height_mm_`, or 1.7 standard deviations of the 3x3 median depth's noise when that
   // is more, up to `max_height_mm_`.
   double residue_height_mm(const cv::Mat& depth_mm) const;
+  double heights(const cv::Mat& depth_mm, const cv::Mat& missing, const cv::Mat& candidates,
+                 cv::Mat& height_mm, cv::Mat* plane_height_mm) const;
 
   const double height_mm_;
   const double max_height_mm_;

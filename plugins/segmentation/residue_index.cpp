@@ -160,8 +160,13 @@ ResidueIndex::ResidueIndex(ColorIndex index, int smoothing_px, int max_smoothing
 
 IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted,
                                   cv::Mat& residue) const {
-  const IndexInfo& range = info(index_);
   thread_local cv::Mat index;
+  return classify(bgr, untrusted, residue, index);
+}
+
+IndexSplit ResidueIndex::classify(const cv::Mat& bgr, const cv::Mat& untrusted, cv::Mat& residue,
+                                  cv::Mat& index) const {
+  const IndexInfo& range = info(index_);
   IndexSplit split = split_at(smoothing_px_, bgr, untrusted, index);
   while (split.smoothing_px < max_smoothing_px_ &&
          !soil_quieter_than(index, untrusted, range, split.threshold, split.smoothing_px,
@@ -202,6 +207,7 @@ IndexSplit ResidueIndex::split_at(int smoothing_px, const cv::Mat& bgr, const cv
   split.threshold = range.boundary;
   split.min_gap = range.min_gap;
   split.smoothing_px = smoothing_px;
+  split.residue_above = range.residue_above;
   if (const auto otsu = otsu_split(histogram)) {
     split.class_gap = static_cast<float>(otsu->upper_mean - otsu->lower_mean) / bins_per_unit;
     if (split.class_gap >= range.min_gap) {
@@ -210,6 +216,39 @@ IndexSplit ResidueIndex::split_at(int smoothing_px, const cv::Mat& bgr, const cv
     }
   }
   return split;
+}
+
+// From a histogram of a thousand bins over the index's range (values outside it in the
+// end bins) of every second pixel of every second row (the index is that of a box at
+// least 3x3): the median is the middle of its bin, and the median absolute deviation the
+// fewest bins around the median's that hold half of the pixels.
+std::optional<IndexSpread> ResidueIndex::spread(const cv::Mat& index, const cv::Mat& among) const {
+  constexpr int kSpreadBins = 1000;
+  constexpr int kSpreadStepPx = 2;
+  const IndexInfo& range = info(index_);
+  const float bins_per_unit = kSpreadBins / (range.high - range.low);
+  std::array<int, kSpreadBins> histogram{};
+  int count = 0;
+  for (int row = 0; row < index.rows; row += kSpreadStepPx) {
+    const auto* value = index.ptr<float>(row);
+    const auto* marked = among.ptr<std::uint8_t>(row);
+    for (int col = 0; col < index.cols; col += kSpreadStepPx) {
+      if (marked[col] == 0 || value[col] != value[col]) continue;  // NaN: no colour
+      const float scaled = (value[col] - range.low) * bins_per_unit;
+      ++histogram[static_cast<std::size_t>(std::clamp(scaled, 0.0f, kSpreadBins - 1.0f))];
+      ++count;
+    }
+  }
+  if (count < kMinSpreadPixels) return std::nullopt;
+  int middle = 0;
+  for (int below = 0; below + histogram[middle] <= count / 2; ++middle) below += histogram[middle];
+  int half_width = 0;
+  for (int within = histogram[middle]; 2 * within < count; ++half_width) {
+    const int left = middle - half_width - 1, right = middle + half_width + 1;
+    within += (left >= 0 ? histogram[left] : 0) + (right < kSpreadBins ? histogram[right] : 0);
+  }
+  return IndexSpread{range.low + (static_cast<float>(middle) + 0.5f) / bins_per_unit,
+                     1.4826f * static_cast<float>(half_width) / bins_per_unit};
 }
 
 std::string IndexSplit::text() const {

@@ -3,6 +3,7 @@
 // boundary. docs/segmentation-variants.md explains the indices and the constants.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,13 +20,21 @@ std::vector<std::string> color_index_names();
 
 // How one frame's colours were split.
 struct IndexSplit {
-  float threshold = 0;       // the index value between soil and residue
-  float class_gap = 0;       // between the means of Otsu's two classes (0: no split)
-  float min_gap = 0;         // the index's least gap between two materials
-  bool two_classes = false;  // false: the frame shows one material, `threshold` is absolute
-  int smoothing_px = 0;      // the box the colours were averaged over: (2r+1)^2
+  float threshold = 0;        // the index value between soil and residue
+  float class_gap = 0;        // between the means of Otsu's two classes (0: no split)
+  float min_gap = 0;          // the index's least gap between two materials
+  bool two_classes = false;   // false: the frame shows one material, `threshold` is absolute
+  bool residue_above = true;  // residue's side of the threshold
+  int smoothing_px = 0;       // the box the colours were averaged over: (2r+1)^2
 
   std::string text() const;  // "class gap 0.012, two materials from 0.05"
+};
+
+// The middle and the spread of a set of pixels' index: the median, and the robust
+// standard deviation (1.4826 times the median absolute deviation).
+struct IndexSpread {
+  float median = 0;
+  float sigma = 0;
 };
 
 class ResidueIndex {
@@ -46,6 +55,15 @@ class ResidueIndex {
   // in `untrusted`, unless the means of its two classes lie closer than the index's
   // minimum gap: then the frame shows one material, and the absolute boundary decides.
   IndexSplit classify(const cv::Mat& bgr, const cv::Mat& untrusted, cv::Mat& residue) const;
+  // The same, and each pixel's index (CV_32FC1, NaN without colour) in `index`.
+  IndexSplit classify(const cv::Mat& bgr, const cv::Mat& untrusted, cv::Mat& residue,
+                      cv::Mat& index) const;
+
+  // The spread of `index` (as classify writes it) over the pixels marked in `among`
+  // (CV_8UC1), to within a thousandth of the index's range, from every second pixel of
+  // every second row; empty for fewer than kMinSpreadPixels of those with a colour.
+  std::optional<IndexSpread> spread(const cv::Mat& index, const cv::Mat& among) const;
+  static constexpr int kMinSpreadPixels = 100;
 
  private:
   IndexSplit split_at(int smoothing_px, const cv::Mat& bgr, const cv::Mat& untrusted,

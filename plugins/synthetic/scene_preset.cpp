@@ -34,6 +34,21 @@ void add_field_conditions(std::vector<ScenePreset>& list, const ScenePreset& bas
   heavy.weathered_fraction = 0.5;
   list.push_back(heavy);
 
+  ScenePreset bleached = heavy;
+  bleached.name = "bleached_cover";
+  bleached.description =
+      "heavy_cover with sun-bleached straw, pale and nearly grey: its colour barely differs "
+      "from the soil's, 518 mm";
+  bleached.straw_bgr = {0.58, 0.74, 0.80};
+  list.push_back(bleached);
+
+  ScenePreset light_soil = in_the_field(base, 45.0);
+  light_soil.name = "light_soil";
+  light_soil.description = "pale, sandy soil under 150 straws, 518 mm";
+  light_soil.straws = 150;
+  light_soil.soil_bgr = {0.30, 0.42, 0.52};
+  list.push_back(light_soil);
+
   ScenePreset tilted = in_the_field(base, 45.0);
   tilted.name = "tilted";
   tilted.description = "ground sloping 3 degrees down towards the image bottom, 150 straws, 585 mm";

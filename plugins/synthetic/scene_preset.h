@@ -19,8 +19,12 @@ struct ScenePreset {
   double stubble_height_spread_mm = 5.0;  // heights are uniform in +-spread
   int straws = 0;                         // lying straws, stacked where they cross
   bool wet_straw = false;                 // dark, soil-like straw
-  double weathered_fraction = 0.0;        // the first-laid (lowest) straws: dark grey, weathered
-  double relief_mm = 1.5;                 // micro-relief amplitude of the soil
+  // Reflectances (BGR, 0..1) of the soil and of fresh straw: brown soil, beige-yellow
+  // straw. Soils run from near black to pale sand, and straw bleaches towards grey.
+  std::array<double, 3> soil_bgr{0.16, 0.23, 0.32};
+  std::array<double, 3> straw_bgr{0.38, 0.70, 0.82};
+  double weathered_fraction = 0.0;  // the first-laid (lowest) straws: dark grey, weathered
+  double relief_mm = 1.5;           // micro-relief amplitude of the soil
   // The ground's shape under the micro-relief, which the truth follows: slopes (about
   // the camera's x axis, farther towards +y when positive; about the y axis, farther
   // towards +x), and ridges and furrows (peak to peak, period, direction from +x).

@@ -1,6 +1,7 @@
 #include "soil_scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -8,14 +9,16 @@
 namespace tilth::synthetic {
 namespace {
 
-// Reflectances (BGR) of the materials; soil is brown, straw beige-yellow, wet straw dark
-// and close to the soil's hue.
-const cv::Vec3f kSoil(0.16f, 0.23f, 0.32f);
-const cv::Vec3f kStraw(0.38f, 0.70f, 0.82f);
+// Reflectances (BGR) of the materials the preset does not choose: wet straw dark and
+// close to the soil's hue.
 const cv::Vec3f kWetStraw(0.14f, 0.22f, 0.30f);
 const cv::Vec3f kStubble(0.32f, 0.60f, 0.72f);
 const cv::Vec3f kWeathered(0.15f, 0.17f, 0.19f);  // grey, darker than the soil
 constexpr double kClutterSigmaMm = 10.0;
+
+cv::Vec3f reflectance(const std::array<double, 3>& bgr) {
+  return {static_cast<float>(bgr[0]), static_cast<float>(bgr[1]), static_cast<float>(bgr[2])};
+}
 
 cv::Vec3b to_bytes(const cv::Vec3f& reflectance) {
   return {cv::saturate_cast<std::uint8_t>(reflectance[0] * 255.0f),
@@ -114,6 +117,7 @@ void SoilScene::add_soil(cv::RNG& rng) {
   rng.fill(tint, cv::RNG::NORMAL, 0.0, 1.0);
   cv::GaussianBlur(tint, tint, cv::Size(0, 0), 6.0 / cell_mm_);
   cv::normalize(tint, tint, -0.18, 0.18, cv::NORM_MINMAX);
+  const cv::Vec3f soil = reflectance(preset_.soil_bgr);
   for (int r = 0; r < soil_height_.rows; ++r) {
     const double y = area_.y + (r + 0.5) * cell_mm_;
     for (int c = 0; c < soil_height_.cols; ++c) {
@@ -122,7 +126,7 @@ void SoilScene::add_soil(cv::RNG& rng) {
       for (const auto& wave : waves)
         h += wave.amplitude * std::sin(wave.kx * x + wave.ky * y + wave.phase);
       soil_height_.at<float>(r, c) = static_cast<float>(h);
-      albedo_.at<cv::Vec3b>(r, c) = to_bytes(kSoil * (1.0f + tint.at<float>(r, c)));
+      albedo_.at<cv::Vec3b>(r, c) = to_bytes(soil * (1.0f + tint.at<float>(r, c)));
     }
   }
 }
@@ -159,7 +163,7 @@ void SoilScene::add_stubble(cv::RNG& rng) {
 // height field cannot show a straw floating on a stalk). The first-laid straws, which end
 // up at the bottom, are weathered when the preset says so.
 void SoilScene::add_straws(cv::RNG& rng) {
-  const cv::Vec3f fresh = preset_.wet_straw ? kWetStraw : kStraw;
+  const cv::Vec3f fresh = preset_.wet_straw ? kWetStraw : reflectance(preset_.straw_bgr);
   const int weathered = static_cast<int>(preset_.weathered_fraction * preset_.straws);
   cv::Mat lying = soil_height_.clone();
   for (int i = 0; i < preset_.straws; ++i) {

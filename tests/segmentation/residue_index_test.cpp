@@ -1,7 +1,10 @@
 // ResidueIndex's smoothing on noisy colours: a frame of dark soil beside shadowed straw
 // (the colours of docs/segmentation.md in shadow), with the sensor noise of a camera at
-// low gain (2 DN) and at a high one (6 DN).
+// low gain (2 DN) and at a high one (6 DN); and the spread of an index of known median and
+// standard deviation.
 #include "residue_index.h"
+
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -78,6 +81,35 @@ TEST(ResidueIndex, AveragesNoisyColoursOverALargerBox) {
 TEST(ResidueIndex, AMaximumAtTheSmoothingKeepsIt) {
   const Classified fixed = classify(ResidueIndex(ColorIndex::kExg, 1, 0), soil_beside_straw(6.0));
   EXPECT_EQ(fixed.split.smoothing_px, 1);
+}
+
+// An exg image of Gaussian values (median 0.02, sigma 0.03), of which the left half is
+// asked for, and a right half far off that must not count: the spread is read from a
+// histogram of thousandths of exg's range of 1, so within 0.002 of the median and 5 % of
+// the sigma (the sample's own error on 4800 pixels is about 2 %).
+TEST(ResidueIndex, TheSpreadOfTheMarkedPixels) {
+  cv::Mat index(kSize, CV_32FC1);
+  cv::RNG(5).fill(index, cv::RNG::NORMAL, 0.02, 0.03);
+  index(kStrawHalf).setTo(0.3);
+  cv::Mat among = cv::Mat::zeros(kSize, CV_8UC1);
+  among(kSoilHalf).setTo(255);
+  const auto spread = ResidueIndex(ColorIndex::kExg, 1, 1).spread(index, among);
+  ASSERT_TRUE(spread.has_value());
+  EXPECT_NEAR(spread->median, 0.02, 0.002);
+  EXPECT_NEAR(spread->sigma, 0.03, 0.0015);
+}
+
+// Pixels without a colour (NaN) do not count, and a spread needs kMinSpreadPixels of the
+// sampled ones (every second pixel of every second row): a 20x20 patch has 100, an 18x18
+// one 81.
+TEST(ResidueIndex, NoSpreadFromTooFewPixels) {
+  const ResidueIndex exg(ColorIndex::kExg, 1, 1);
+  const cv::Mat all(kSize, CV_8UC1, cv::Scalar(255));
+  for (const int side : {20, 18}) {
+    cv::Mat index(kSize, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+    index(cv::Rect(0, 0, side, side)).setTo(0.01);
+    EXPECT_EQ(exg.spread(index, all).has_value(), side == 20) << side << "x" << side;
+  }
 }
 
 }  // namespace
