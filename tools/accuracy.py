@@ -36,13 +36,13 @@ VARIANTS = os.path.join(SOURCE, "graphs", "ab", "segmentation-variants.json")
 SUMMARY_VARIANT = "field"
 
 STATIC = ["case_a", "case_b", "case_c", "case_d", "case_e", "wet_straw", "shadows",
-          "low_sun", "heavy_cover", "bleached_cover", "light_soil", "tilted", "tilted_5",
-          "ridges", "tall_stubble", "field"]
+          "low_sun", "heavy_cover", "bleached_cover", "light_soil", "chaff", "bleached_chaff",
+          "tilted", "tilted_5", "ridges", "tall_stubble", "field"]
 COVERED = ["covered", "covered_mat", "covered_wet"]
 ON_THE_FIELD_RIG = ["case_c", "wet_straw", "low_sun", "heavy_cover", "tilted_5", "ridges",
                     "tall_stubble", "field", "covered"]
-SMALL_STATIC = ["case_c", "wet_straw", "low_sun", "heavy_cover", "bleached_cover", "tilted_5",
-                "ridges", "tall_stubble", "covered"]
+SMALL_STATIC = ["case_c", "wet_straw", "low_sun", "heavy_cover", "tilted_5", "ridges",
+                "tall_stubble", "covered"]
 
 # The bounds of issue #15 ("Done when"), which --check holds a variant to.
 MAX_ABS_MEAN_MM = 0.5

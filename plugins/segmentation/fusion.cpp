@@ -148,7 +148,7 @@ StageDescriptor describe_fusion() {
       segmented_roi_param(),
       speckle_px_param(1),
       min_value_param(),
-      ParamSpec::number("soil_color_sigmas", 2.5)
+      ParamSpec::number("soil_color_sigmas", 1.5)
           .range(0, 10)
           .describe("at the soil's level by depth, colour is residue only this many robust "
                     "standard deviations beyond the median colour there (bleached straw); "

@@ -49,6 +49,22 @@ void add_field_conditions(std::vector<ScenePreset>& list, const ScenePreset& bas
   light_soil.soil_bgr = {0.30, 0.42, 0.52};
   list.push_back(light_soil);
 
+  ScenePreset chaff = in_the_field(base, 45.0);
+  chaff.name = "chaff";
+  chaff.description =
+      "case A's stubble and 5000 pieces of chaff and chopped straw, 10-40 mm long and 1-2 mm "
+      "thick: residue lower than the height cue sees, 518 mm";
+  chaff.straws = 5000;
+  chaff.straw_length_mm = {10.0, 40.0};
+  chaff.straw_radius_mm = {0.5, 1.0};
+  list.push_back(chaff);
+
+  ScenePreset bleached_chaff = chaff;
+  bleached_chaff.name = "bleached_chaff";
+  bleached_chaff.description = "chaff, sun-bleached: pale, nearly grey and lying flat, 518 mm";
+  bleached_chaff.straw_bgr = bleached.straw_bgr;
+  list.push_back(bleached_chaff);
+
   ScenePreset tilted = in_the_field(base, 45.0);
   tilted.name = "tilted";
   tilted.description = "ground sloping 3 degrees down towards the image bottom, 150 straws, 585 mm";

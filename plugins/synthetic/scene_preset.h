@@ -18,7 +18,11 @@ struct ScenePreset {
   double stubble_height_mm = 65.0;
   double stubble_height_spread_mm = 5.0;  // heights are uniform in +-spread
   int straws = 0;                         // lying straws, stacked where they cross
-  bool wet_straw = false;                 // dark, soil-like straw
+  // Their sizes, uniform between the bounds: whole straws 40-250 mm long and 3-6 mm thick;
+  // chaff and chopped straw are shorter and thinner.
+  std::array<double, 2> straw_length_mm{40.0, 250.0};
+  std::array<double, 2> straw_radius_mm{1.5, 3.0};
+  bool wet_straw = false;  // dark, soil-like straw
   // Reflectances (BGR, 0..1) of the soil and of fresh straw: brown soil, beige-yellow
   // straw. Soils run from near black to pale sand, and straw bleaches towards grey.
   std::array<double, 3> soil_bgr{0.16, 0.23, 0.32};

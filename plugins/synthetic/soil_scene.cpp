@@ -157,7 +157,7 @@ void SoilScene::add_stubble(cv::RNG& rng) {
   }
 }
 
-// Lying straws: cylinders of 3-6 mm diameter and 40-250 mm length at random angles.
+// Lying straws: cylinders of the preset's diameters and lengths at random angles.
 // Each rests on the soil or the highest straw under its axis, so straws stack where
 // they cross; standing stubble pokes through them rather than holding them up (a
 // height field cannot show a straw floating on a stalk). The first-laid straws, which end
@@ -171,8 +171,8 @@ void SoilScene::add_straws(cv::RNG& rng) {
     const double cx = rng.uniform(area_.x, area_.x + area_.width);
     const double cy = rng.uniform(area_.y, area_.y + area_.height);
     const double angle = rng.uniform(0.0, CV_PI);
-    const double half = rng.uniform(20.0, 125.0);
-    const double radius = rng.uniform(1.5, 3.0);
+    const double half = rng.uniform(preset_.straw_length_mm[0] / 2, preset_.straw_length_mm[1] / 2);
+    const double radius = rng.uniform(preset_.straw_radius_mm[0], preset_.straw_radius_mm[1]);
     const float shade = static_cast<float>(rng.uniform(0.8, 1.15));
     const double ux = std::cos(angle);
     const double uy = std::sin(angle);
