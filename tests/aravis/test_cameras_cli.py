@@ -108,37 +108,38 @@ class CameraGraph(unittest.TestCase):
             with open(graph, "w") as out:
                 json.dump(GRAPH, out)
             env = dict(os.environ, TILTH_PLUGIN_PATH=TEST_PLUGINS)
-            log = open(os.path.join(directory, "stderr.txt"), "w+")
-            run = subprocess.Popen([TILTH, "run", graph], stdout=subprocess.PIPE, stderr=log,
-                                   text=True, env=env)
-            lines, unreadable = [], []
+            with open(os.path.join(directory, "stderr.txt"), "w+") as log:
+                run = subprocess.Popen([TILTH, "run", graph], stdout=subprocess.PIPE, stderr=log,
+                                       text=True, env=env)
+                lines, unreadable = [], []
 
-            def read():
-                for text in run.stdout:
-                    try:
-                        lines.append(json.loads(text))
-                    except ValueError:
-                        unreadable.append(text)
+                def read():
+                    for text in run.stdout:
+                        try:
+                            lines.append(json.loads(text))
+                        except ValueError:
+                            unreadable.append(text)
 
-            reader = threading.Thread(target=read)
-            reader.start()
-            try:
-                self.wait_for(lines, lambda l: l["label"] == "depth" and l["image"], 10)
-                time.sleep(10.5)
-                killed_ns = time.time_ns()
-                DEPTH.kill()
-                time.sleep(1.5)
-                restarted_ns = time.time_ns()
-                DEPTH.start()
-                self.wait_for(lines, lambda l: l["label"] == "depth" and l["image"] and
-                              l["host_ns"] > restarted_ns, 10)
-                time.sleep(1.0)
-            finally:
-                run.send_signal(signal.SIGINT)
-                code = run.wait(timeout=20)
-                reader.join()
-                log.seek(0)
-                stderr = log.read()
+                reader = threading.Thread(target=read)
+                reader.start()
+                try:
+                    self.wait_for(lines, lambda l: l["label"] == "depth" and l["image"], 10)
+                    time.sleep(10.5)
+                    killed_ns = time.time_ns()
+                    DEPTH.kill()
+                    time.sleep(1.5)
+                    restarted_ns = time.time_ns()
+                    DEPTH.start()
+                    self.wait_for(lines, lambda l: l["label"] == "depth" and l["image"] and
+                                  l["host_ns"] > restarted_ns, 10)
+                    time.sleep(1.0)
+                finally:
+                    run.send_signal(signal.SIGINT)
+                    code = run.wait(timeout=20)
+                    reader.join()
+                    run.stdout.close()
+                    log.seek(0)
+                    stderr = log.read()
             self.assertEqual(code, 0, stderr)
             self.assertEqual(unreadable, [])
 
