@@ -331,12 +331,12 @@ double SoilSurface::heights(const cv::Mat& depth_mm, const cv::Mat& missing,
     plane = farthest_plane(depth, missing, candidates, kBesideEnvelopeStepPx);
   }
   if (plane_height_mm != nullptr) heights_above(plane, depth, missing, *plane_height_mm);
-  if (from_plane && !plane) {
-    height_mm.create(depth_mm.size(), CV_32FC1);
-    height_mm.setTo(std::numeric_limits<float>::quiet_NaN());
-    return residue_mm;
-  }
   if (from_plane) {
+    if (!plane) {
+      height_mm.create(depth_mm.size(), CV_32FC1);
+      height_mm.setTo(std::numeric_limits<float>::quiet_NaN());
+      return residue_mm;
+    }
     surface.create(supported.size(), CV_32FC1);
     for (int row = 0; row < surface.rows; ++row) {
       auto* s = surface.ptr<float>(row);

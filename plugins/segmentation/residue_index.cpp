@@ -19,6 +19,8 @@ namespace tilth::segmentation {
 namespace {
 
 constexpr int kBins = 256;
+// A normal distribution's standard deviation per median absolute deviation.
+constexpr float kSigmaPerMad = 1.4826f;
 
 // Histogram range (values outside are counted in the end bins), which side residue is
 // on, the absolute boundary for frames of one material, and the least gap between
@@ -118,7 +120,7 @@ void index_and_histogram(const cv::Mat& summed, const cv::Mat& untrusted, const 
 bool soil_quieter_than(const cv::Mat& index, const cv::Mat& untrusted, const IndexInfo& range,
                        float threshold, int smoothing_px, float limit) {
   const int apart = 2 * smoothing_px + 1;
-  const float within = limit * std::numbers::sqrt2_v<float> / 1.4826f;
+  const float within = limit * std::numbers::sqrt2_v<float> / kSigmaPerMad;
   const float sign = range.residue_above ? 1.0f : -1.0f;  // soil: sign * index < sign * threshold
   const float soil_below = sign * threshold;
   int pairs = 0;
@@ -248,7 +250,7 @@ std::optional<IndexSpread> ResidueIndex::spread(const cv::Mat& index, const cv::
     within += (left >= 0 ? histogram[left] : 0) + (right < kSpreadBins ? histogram[right] : 0);
   }
   return IndexSpread{range.low + (static_cast<float>(middle) + 0.5f) / bins_per_unit,
-                     1.4826f * static_cast<float>(half_width) / bins_per_unit};
+                     kSigmaPerMad * static_cast<float>(half_width) / bins_per_unit};
 }
 
 std::string IndexSplit::text() const {
