@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace tilth {
@@ -11,8 +12,12 @@ namespace {
 constexpr int kApart = 2;
 constexpr int kRowStep = 4;
 constexpr int kMinPairs = 100;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // The median absolute difference of a standard deviation sigma.
 constexpr float kDifferencePerSigma = std::numbers::sqrt2_v<float> / 1.4826f;
+
+// A depth that is a measurement: neither NaN, nor infinite, nor <= 0.
+bool measured(float depth_mm) { return depth_mm > 0 && depth_mm < kInfinity; }
 
 // Calls `pair(a, b)` for every pair of depths two columns apart on the sampled rows.
 template <class Pair>
@@ -28,12 +33,11 @@ void for_each_pair(const cv::Mat& depth_mm, const cv::Rect& area, Pair&& pair) {
 }  // namespace
 
 float depth_noise_mm(const cv::Mat& depth_mm, const cv::Rect& area, float at_least_mm) {
-  // NaN compares false: no depth, no pair.
   int pairs = 0;
   int within = 0;
   const float within_mm = at_least_mm * kDifferencePerSigma;
   for_each_pair(depth_mm, area, [&](float a, float b) {
-    const int counted = (a > 0) & (b > 0);
+    const int counted = measured(a) & measured(b);
     pairs += counted;
     within += counted & (std::abs(b - a) <= within_mm);
   });
@@ -43,10 +47,10 @@ float depth_noise_mm(const cv::Mat& depth_mm, const cv::Rect& area, float at_lea
   // The median from a histogram of 0.1 mm bins; the last holds every larger difference.
   constexpr float kBinsPerMm = 10.0f;
   std::array<int, 1000> counts{};
+  constexpr auto kLastBin = static_cast<float>(counts.size() - 1);
   for_each_pair(depth_mm, area, [&](float a, float b) {
-    if (!(a > 0 && b > 0)) return;
-    const int bin = static_cast<int>(std::abs(b - a) * kBinsPerMm);
-    ++counts[static_cast<std::size_t>(std::min(bin, static_cast<int>(counts.size()) - 1))];
+    if (!(measured(a) && measured(b))) return;
+    ++counts[static_cast<std::size_t>(std::min(std::abs(b - a) * kBinsPerMm, kLastBin))];
   });
   int below = 0;
   std::size_t median_bin = 0;

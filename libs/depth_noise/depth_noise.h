@@ -8,7 +8,7 @@
 
 namespace tilth {
 
-// Over every fourth row of `area` of `depth_mm` (CV_32FC1, NaN or <= 0: no depth); 0 when
+// Over every fourth row of `area` of `depth_mm` (CV_32FC1; NaN, infinite or <= 0: no depth); 0 when
 // under 100 pairs have depth. A frame whose noise is at most `at_least_mm` gives
 // `at_least_mm`, found with one count of the pairs within it (about 10 us for the chain's
 // region), without the median's histogram.

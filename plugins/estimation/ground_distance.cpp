@@ -37,6 +37,9 @@ namespace {
 
 constexpr float kLargest = std::numeric_limits<float>::max();
 
+// Every second pixel of every second row tells the soil beyond the ground well enough.
+constexpr int kBeyondSampleStep = 2;
+
 // Scales the median absolute deviation to the standard deviation of normal data.
 constexpr double kMadToSigma = 1.4826;
 
@@ -129,6 +132,7 @@ class GroundDistanceEstimator final : public Transform {
       out.invalidate(InvalidCause::kTooLittleSoil, std::move(shortfall));
     } else {
       measure(depths, out);
+      gates_.check(out, soil_beyond(soil.mm, roi, out.distance_mm));
       gates_.check(out);
     }
     frame.set_output(0, message);
@@ -175,6 +179,21 @@ class GroundDistanceEstimator final : public Transform {
     out.distance_mm = distance_mm;
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm);
+  }
+
+  // The soil of `roi` beyond a level ground at `distance_mm`, by quadrant around the
+  // region's centre (pixel centres at +0.5).
+  SoilBeyond soil_beyond(const cv::Mat& soil_mm, const cv::Rect& roi, double distance_mm) const {
+    SoilBeyond beyond = gates_.soil_beyond(soil_mm, roi);
+    const cv::Point2d centre(roi.x + 0.5 * roi.width, roi.y + 0.5 * roi.height);
+    for (int row = roi.y; row < roi.y + roi.height; row += kBeyondSampleStep) {
+      const float* depth = soil_mm.ptr<float>(row);
+      for (int col = roi.x; col < roi.x + roi.width; col += kBeyondSampleStep) {
+        if (std::isfinite(depth[col]))
+          beyond.add(col + 0.5 - centre.x, row + 0.5 - centre.y, depth[col] - distance_mm);
+      }
+    }
+    return beyond;
   }
 
   const RegionOfInterest region_;

@@ -436,9 +436,12 @@ class GroundPlaneEstimator final : public Transform {
     double squares = 0.0;
     double votes = 0.0;
     double inlier_votes = 0.0;
+    SoilBeyond beyond = gates_.soil_beyond(soil_mm, sampling.roi);
     for (const SoilPoint& point : points) {
       votes += point.vote;
       const double residual_mm = surface->residual_mm(point);
+      beyond.add(point.x - tool_point_mm_[0], point.y - tool_point_mm_[1], residual_mm,
+                 point.weight);
       if (std::abs(residual_mm) > band_mm) continue;
       inlier_votes += point.vote;
       inlier_weight += point.weight;
@@ -464,6 +467,8 @@ class GroundPlaneEstimator final : public Transform {
     out.tilt_y_deg = degrees(std::atan(surface->slope_x_at_origin()));
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
+
+    gates_.check(out, beyond);
   }
 
   // The quadric on the tool's level, re-fitted until it settles; nullopt when the points

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "depth_noise/depth_noise.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 
@@ -73,7 +74,9 @@ PlausibilityGates::PlausibilityGates(const Params& params)
       max_spread_mm_(params.number("max_spread_mm")),
       min_confidence_(params.number("min_confidence")),
       max_clipped_fraction_(params.number("max_clipped_fraction")),
-      min_color_contrast_(params.number("min_color_contrast")) {
+      min_color_contrast_(params.number("min_color_contrast")),
+      soil_beyond_mm_(params.number("soil_beyond_mm")),
+      max_soil_beyond_(params.number("max_soil_beyond")) {
   if (!(min_distance_mm_ < max_distance_mm_)) {
     throw Error("parameters 'min_distance_mm' and 'max_distance_mm': expected min < max, got " +
                 one_decimal(min_distance_mm_) + " and " + one_decimal(max_distance_mm_));
@@ -94,6 +97,15 @@ std::vector<ParamSpec> PlausibilityGates::params() {
           .range(0.1, std::nullopt)
           .in_unit("mm")
           .describe("soil depths spread more than this are not one surface: invalid"),
+      ParamSpec::number("soil_beyond_mm", 10.0)
+          .range(0.1, std::nullopt)
+          .in_unit("mm")
+          .describe("soil deeper than the ground measured by more than this (or 3 times the "
+                    "depth noise) lies beyond it"),
+      ParamSpec::number("max_soil_beyond", 0.02)
+          .range(0, 1)
+          .describe("more of the soil beyond the ground on every side of the measuring point "
+                    "(each quadrant) is residue taken for soil: invalid; 1 = no check"),
       ParamSpec::number("min_confidence", 0.02)
           .range(0, 1)
           .describe("a measurement trusted less than this is invalid"),
@@ -148,6 +160,24 @@ void PlausibilityGates::check(GroundDistance& out) const {
   } else if (out.confidence < min_confidence_) {
     out.invalidate(InvalidCause::kLowConfidence, "confidence " + three_decimals(out.confidence) +
                                                      " < " + three_decimals(min_confidence_));
+  }
+}
+
+SoilBeyond PlausibilityGates::soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const {
+  const float noise_mm =
+      depth_noise_mm(soil_mm, roi, static_cast<float>(soil_beyond_mm_ / kBeyondPerNoise));
+  return SoilBeyond(std::max(soil_beyond_mm_, kBeyondPerNoise * noise_mm));
+}
+
+void PlausibilityGates::check(GroundDistance& out, const SoilBeyond& beyond) const {
+  if (!out.valid || max_soil_beyond_ >= 1.0) return;
+  const double share = beyond.least_share();
+  if (share > max_soil_beyond_) {
+    out.invalidate(InvalidCause::kNotOneSurface,
+                   "soil beyond the ground measured on every side: " + one_decimal(100.0 * share) +
+                       " % of the soil or more in each quadrant lies over " +
+                       one_decimal(beyond.beyond_mm()) + " mm deeper > " +
+                       one_decimal(100.0 * max_soil_beyond_) + " % (residue taken for soil?)");
   }
 }
 

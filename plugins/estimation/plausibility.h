@@ -1,6 +1,7 @@
 // The plausibility gates every ground estimator applies, so that no implausible number is
 // ever served as valid: a colour image that carries information, a distance the rig can
-// physically see, soil depths that form one surface, and enough confidence. A gate only
+// physically see, soil depths that form one surface, no soil beyond the ground measured
+// on every side (soil_beyond.h), and enough confidence. A gate only
 // ever invalidates a measurement (with its cause and reason); it never changes a number.
 #pragma once
 
@@ -10,6 +11,7 @@
 
 #include <opencv2/core/types.hpp>
 
+#include "soil_beyond.h"
 #include "tilth/messages/ground_distance.h"
 #include "tilth/messages/registered_color.h"
 #include "tilth/param_spec.h"
@@ -34,6 +36,16 @@ class PlausibilityGates {
   // Invalidates a measured, valid `out` whose distance, spread or confidence is implausible.
   void check(GroundDistance& out) const;
 
+  // What counts the soil beyond the ground in `roi` of these soil depths: deeper by
+  // soil_beyond_mm, or by kBeyondPerNoise times their noise when that is more.
+  SoilBeyond soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const;
+  // Invalidates a valid `out` with more than max_soil_beyond of the soil beyond it on
+  // every side.
+  void check(GroundDistance& out, const SoilBeyond& beyond) const;
+
+  // Noise alone puts 0.13 % of the soil beyond three sigmas.
+  static constexpr double kBeyondPerNoise = 3.0;
+
  private:
   double min_distance_mm_;
   double max_distance_mm_;
@@ -41,6 +53,8 @@ class PlausibilityGates {
   double min_confidence_;
   double max_clipped_fraction_;
   double min_color_contrast_;
+  double soil_beyond_mm_;
+  double max_soil_beyond_;
 };
 
 }  // namespace tilth::estimation

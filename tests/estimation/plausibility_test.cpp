@@ -187,5 +187,63 @@ TEST(Plausibility, ThePlaneEstimatorAppliesTheSameGates) {
   EXPECT_EQ(run(518.0f, uniform_color({0, 0, 0})).cause, InvalidCause::kImageUnusable);
 }
 
+// Pale straw taken for soil at 500 mm, the true soil visible 30 mm beyond it in the gaps
+// on every side: pixels (2 mod 4, 2 mod 4), a quarter of those the gate samples (every
+// second pixel of every second row) and none of those the noise is measured on (every
+// fourth row from the region's first).
+cv::Mat straw_over_soil_gaps() {
+  cv::Mat depth = flat_soil(500.0f);
+  for (int row = 2; row < depth.rows; row += 4) {
+    for (int col = 2; col < depth.cols; col += 4) depth.at<float>(row, col) = 530.0f;
+  }
+  return depth;
+}
+
+TEST(Plausibility, SoilBeyondTheGroundOnEverySideIsResidueTakenForSoil) {
+  expect_invalid(estimate(straw_over_soil_gaps()), InvalidCause::kNotOneSurface,
+                 "soil beyond the ground measured on every side: 25.0 % of the soil or more in "
+                 "each quadrant lies over 10.0 mm deeper > 2.0 % (residue taken for soil?)");
+  const GroundDistance unchecked =
+      estimate(straw_over_soil_gaps(), nullptr, {{"max_soil_beyond", 1}});
+  EXPECT_TRUE(unchecked.valid) << unchecked.invalid_reason;
+  EXPECT_EQ(unchecked.distance_mm, 500.0);
+  // The gaps 30 mm deeper are soil beyond a 25 mm threshold, not a 30 mm one.
+  EXPECT_FALSE(estimate(straw_over_soil_gaps(), nullptr, {{"soil_beyond_mm", 25}}).valid);
+  EXPECT_TRUE(estimate(straw_over_soil_gaps(), nullptr, {{"soil_beyond_mm", 30}}).valid);
+}
+
+// A step down beside the measuring point: the right third of the region 30 mm deeper,
+// soil beyond the ground on one side only.
+TEST(Plausibility, SoilBeyondTheGroundOnOneSideIsAStep) {
+  cv::Mat step = flat_soil(500.0f);
+  step.colRange(kDefaultRoi.x + 2 * kDefaultRoi.width / 3, 640).setTo(530.0);
+  const GroundDistance out = estimate(step);
+  EXPECT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_EQ(out.distance_mm, 500.0);
+}
+
+// The plane estimator counts the soil points of its fit, around its tool point: a tenth of
+// the pixels, at random, 30 mm beyond the ground.
+TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
+  cv::Mat gaps = flat_soil(500.0f);
+  cv::Mat chance(gaps.size(), CV_32FC1);
+  cv::RNG(15).fill(chance, cv::RNG::UNIFORM, 0.0f, 1.0f);
+  gaps.setTo(530.0, chance < 0.1f);
+  const auto run = [&](const json& params) {
+    json all = params;
+    all["calibration"] = kPaperRig.string();
+    TransformHarness plane(describe_ground_plane(), all);
+    return plane.run({depth_message(gaps), nullptr})[0].get<GroundDistance>();
+  };
+  const GroundDistance out = run(json::object());
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(out.cause, InvalidCause::kNotOneSurface);
+  const std::string expected = "soil beyond the ground measured on every side: ";
+  EXPECT_EQ(out.invalid_reason.substr(0, expected.size()), expected) << out.invalid_reason;
+  const GroundDistance unchecked = run({{"max_soil_beyond", 1}});
+  EXPECT_TRUE(unchecked.valid) << unchecked.invalid_reason;
+  EXPECT_NEAR(unchecked.distance_mm, 500.0, 0.01);
+}
+
 }  // namespace
 }  // namespace tilth::estimation

@@ -48,6 +48,21 @@ TEST(DepthNoise, EdgesRaiseItByTheirShareHolesDoNot) {
   EXPECT_NEAR(depth_noise_mm(depth, kRegion, 1.0f), 1.135 * 5.0, 0.015 * 5.7 + 0.05);
 }
 
+// Infinite depths (a saturated or overflowing conversion) are no depth either; once they
+// indexed the histogram out of bounds. Differences over 100 mm share its last bin.
+TEST(DepthNoise, InfiniteDepthsAreNoDepth) {
+  cv::Mat depth = noisy_plane(5.0);
+  const cv::Mat clean = depth.clone();
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = v % 3; u < depth.cols; u += 3) {
+      depth.at<float>(v, u) = u % 2 == 0 ? INFINITY : -INFINITY;
+    }
+  }
+  depth.at<float>(kRegion.y, kRegion.x + 1) = 3e38f;
+  const float noise = depth_noise_mm(depth, kRegion, 1.0f);
+  EXPECT_NEAR(noise, depth_noise_mm(clean, kRegion, 1.0f), 0.05 * 5.0);
+}
+
 TEST(DepthNoise, TooFewPairsGiveZero) {
   cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(NAN));
   depth(cv::Rect(200, 200, 10, 4)).setTo(518.0f);  // 8 pairs on one sampled row
