@@ -16,7 +16,8 @@ namespace tilth {
 enum class InvalidCause : std::uint8_t {
   kNone = 0,           // valid
   kTooLittleSoil = 1,  // residue (or nothing) covers the region: too little soil visible
-  kNotOneSurface = 2,  // the soil depths spread too widely, or no surface fits them
+  kNotOneSurface = 2,  // the soil depths spread too widely, no surface fits them, or soil
+                       // lies beyond the ground on every side (residue taken for soil)
   kOutOfRange = 3,     // the distance lies outside what the rig can physically see
   kLowConfidence = 4,  // the estimator trusts its own number too little
   kImageUnusable = 5,  // the colour image carries no information: clipped, black or flat
