@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <numbers>
 
 namespace tilth {
@@ -12,12 +11,11 @@ namespace {
 constexpr int kApart = 2;
 constexpr int kRowStep = 4;
 constexpr int kMinPairs = 100;
-constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // The median absolute difference of a standard deviation sigma.
 constexpr float kDifferencePerSigma = std::numbers::sqrt2_v<float> / 1.4826f;
 
 // A depth that is a measurement: neither NaN, nor infinite, nor <= 0.
-bool measured(float depth_mm) { return depth_mm > 0 && depth_mm < kInfinity; }
+bool measured(float depth_mm) { return std::isfinite(depth_mm) && depth_mm > 0; }
 
 // Calls `pair(a, b)` for every pair of depths two columns apart on the sampled rows.
 template <class Pair>

@@ -24,6 +24,7 @@
 #include "estimators.h"
 #include "plausibility.h"
 #include "rank_selection.h"
+#include "soil_beyond.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 #include "tilth/message_pool.h"
@@ -132,7 +133,7 @@ class GroundDistanceEstimator final : public Transform {
       out.invalidate(InvalidCause::kTooLittleSoil, std::move(shortfall));
     } else {
       measure(depths, out);
-      gates_.check(out, soil_beyond(soil.mm, roi, out.distance_mm));
+      gates_.check_soil_beyond(out, soil_beyond(soil.mm, roi, out.distance_mm));
       gates_.check(out);
     }
     frame.set_output(0, message);
@@ -189,8 +190,9 @@ class GroundDistanceEstimator final : public Transform {
     for (int row = roi.y; row < roi.y + roi.height; row += kBeyondSampleStep) {
       const float* depth = soil_mm.ptr<float>(row);
       for (int col = roi.x; col < roi.x + roi.width; col += kBeyondSampleStep) {
-        if (std::isfinite(depth[col]))
+        if (std::isfinite(depth[col])) {
           beyond.add(col + 0.5 - centre.x, row + 0.5 - centre.y, depth[col] - distance_mm);
+        }
       }
     }
     return beyond;

@@ -468,7 +468,7 @@ class GroundPlaneEstimator final : public Transform {
     out.valid = true;
     out.confidence = confidence(out.soil_fraction, out.spread_mm) * inlier_fraction;
 
-    gates_.check(out, beyond);
+    gates_.check_soil_beyond(out, beyond);
   }
 
   // The quadric on the tool's level, re-fitted until it settles; nullopt when the points

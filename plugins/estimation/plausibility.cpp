@@ -17,6 +17,11 @@ constexpr int kClippedWhite = 250;
 constexpr int kClippedBlack = 5;
 constexpr int kSampleStep = 2;
 
+// Noise alone puts 0.13 % of the soil beyond three sigmas. At most three times the
+// threshold: depths so noisy are no surface, and must not switch the gate off.
+constexpr double kBeyondPerNoise = 3.0;
+constexpr double kMaxBeyondPerThreshold = 3.0;
+
 // What the valid colour pixels of a region show.
 struct ColorEvidence {
   std::int64_t with_depth = 0;  // pixels whose colour registration could look up
@@ -166,10 +171,11 @@ void PlausibilityGates::check(GroundDistance& out) const {
 SoilBeyond PlausibilityGates::soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const {
   const float noise_mm =
       depth_noise_mm(soil_mm, roi, static_cast<float>(soil_beyond_mm_ / kBeyondPerNoise));
-  return SoilBeyond(std::max(soil_beyond_mm_, kBeyondPerNoise * noise_mm));
+  return SoilBeyond(std::clamp(kBeyondPerNoise * noise_mm, soil_beyond_mm_,
+                               kMaxBeyondPerThreshold * soil_beyond_mm_));
 }
 
-void PlausibilityGates::check(GroundDistance& out, const SoilBeyond& beyond) const {
+void PlausibilityGates::check_soil_beyond(GroundDistance& out, const SoilBeyond& beyond) const {
   if (!out.valid || max_soil_beyond_ >= 1.0) return;
   const double share = beyond.least_share();
   if (share > max_soil_beyond_) {

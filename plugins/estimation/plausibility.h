@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
 #include "soil_beyond.h"
@@ -37,14 +38,12 @@ class PlausibilityGates {
   void check(GroundDistance& out) const;
 
   // What counts the soil beyond the ground in `roi` of these soil depths: deeper by
-  // soil_beyond_mm, or by kBeyondPerNoise times their noise when that is more.
+  // soil_beyond_mm, or by three times their noise when that is more (up to three times
+  // soil_beyond_mm).
   SoilBeyond soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const;
   // Invalidates a valid `out` with more than max_soil_beyond of the soil beyond it on
-  // every side.
-  void check(GroundDistance& out, const SoilBeyond& beyond) const;
-
-  // Noise alone puts 0.13 % of the soil beyond three sigmas.
-  static constexpr double kBeyondPerNoise = 3.0;
+  // every side. The estimators apply it before check(out).
+  void check_soil_beyond(GroundDistance& out, const SoilBeyond& beyond) const;
 
  private:
   double min_distance_mm_;

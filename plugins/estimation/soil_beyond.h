@@ -1,11 +1,12 @@
 // How much of the soil lies beyond the ground measured, on every side of the point it is
 // measured at. Residue lies on the soil, so a ground with soil beyond it all around is
-// residue taken for soil (pale straw on pale soil, colour clusters the wrong way round);
-// a step or a rut puts soil beyond it on one side only, and a tilt on two.
+// residue taken for soil (pale straw on pale soil, colour clusters the wrong way round).
+// A step, a rut or a furrow that does not pass through the point puts soil beyond it in
+// three of the four quadrants around it at most (the quadrant facing away from it lies
+// wholly on the near side), and a tilt in two.
 #pragma once
 
 #include <array>
-#include <cstddef>
 
 namespace tilth::estimation {
 
@@ -22,14 +23,15 @@ class SoilBeyond {
     if (deeper_than_ground_mm > beyond_mm_) beyond_[quadrant] += weight;
   }
 
-  // The least share of the soil (by weight) lying beyond the ground among the quadrants
-  // around the measuring point that hold at least kMinQuadrantShare of the soil; 0
-  // without soil.
+  // The least share of the soil (by weight) lying beyond the ground among the four
+  // quadrants around the measuring point; 0 unless each holds at least kMinQuadrantShare
+  // of the soil.
   double least_share() const;
 
   double beyond_mm() const { return beyond_mm_; }
 
-  // A quadrant with less soil than this tells nothing: residue may cover it.
+  // A quadrant with less soil than this tells nothing (residue or the region's edge may
+  // hide it), and without it the other three cannot tell residue from a step.
   static constexpr double kMinQuadrantShare = 0.05;
 
  private:

@@ -245,5 +245,20 @@ TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
   EXPECT_NEAR(unchecked.distance_mm, 500.0, 0.01);
 }
 
+// A step beside an off-axis tool point: the tool 110 mm down the image (row 352 at
+// 500 mm on the paper's rig, fy 510), so the quadrants below it hold 7 of the region's 240
+// rows (3 %, under SoilBeyond::kMinQuadrantShare), and the ground 30 mm deeper over the
+// region's top 80 rows, a third of both quadrants above it. Two quadrants alone cannot
+// tell a step from residue: valid, at the tool's level.
+TEST(Plausibility, AStepBesideAnOffAxisToolIsNoResidue) {
+  cv::Mat step = flat_soil(500.0f);
+  step.rowRange(0, kDefaultRoi.y + 80).setTo(530.0);
+  TransformHarness plane(describe_ground_plane(),
+                         {{"calibration", kPaperRig.string()}, {"tool_point", {0, 110}}});
+  const GroundDistance out = plane.run({depth_message(step), nullptr})[0].get<GroundDistance>();
+  EXPECT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_NEAR(out.distance_mm, 500.0, 0.01);
+}
+
 }  // namespace
 }  // namespace tilth::estimation

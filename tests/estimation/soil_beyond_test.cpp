@@ -46,17 +46,18 @@ TEST(SoilBeyond, OnlyMoreThanTheThresholdDeeperIsBeyond) {
   EXPECT_DOUBLE_EQ(soil.beyond_mm(), 10.0);
 }
 
-// Residue covering a quadrant leaves it a few soil points: they tell nothing, whatever
-// their depths; the points weigh by their weights.
-TEST(SoilBeyond, AQuadrantWithLittleSoilTellsNothing) {
+// Residue covering a quadrant, or the region's edge near an off-axis tool point, leaves it
+// a few soil points: they tell nothing, and the other three alone cannot tell residue from
+// a step, so there is no verdict. The points weigh by their weights.
+TEST(SoilBeyond, AQuadrantWithLittleSoilLeavesNoVerdict) {
   SoilBeyond soil(10.0);
   add_quadrant(soil, -1, -1, 50);
   add_quadrant(soil, 1, -1, 50);
   add_quadrant(soil, -1, 1, 50);
-  soil.add(1, 1, 0.0, 15.0);  // 15 of 315: under kMinQuadrantShare, 5 %
-  EXPECT_DOUBLE_EQ(soil.least_share(), 0.5);
-  soil.add(1, 1, 0.0, 2.0);  // 17 of 317: over it
+  soil.add(1, 1, 20.0, 15.0);  // 15 of 315: under kMinQuadrantShare, 5 %
   EXPECT_DOUBLE_EQ(soil.least_share(), 0.0);
+  soil.add(1, 1, 0.0, 2.0);  // 17 of 317: over it; 15 of its 17 beyond
+  EXPECT_DOUBLE_EQ(soil.least_share(), 0.5);
 }
 
 TEST(SoilBeyond, NoSoilNoShare) { EXPECT_DOUBLE_EQ(SoilBeyond(10.0).least_share(), 0.0); }

@@ -49,7 +49,7 @@ class ResidueTakenForSoil(unittest.TestCase):
     def test_no_frame_is_valid_and_wrong(self):
         frames = frames_of(self.report, "gated")
         self.assertEqual(len(frames), FRAMES)
-        for frame in frames:
+        for frame in frames:  # a frame left valid must be within issue #15's 1.5 mm
             if frame["valid"]:
                 self.assertLess(abs(frame["distance_mm"] - frame["truth_mm"]), 1.5, frame)
         reasons = [frame["invalid_reason"] for frame in frames if not frame["valid"]]
