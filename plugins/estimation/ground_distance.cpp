@@ -21,6 +21,7 @@
 #include <span>
 #include <vector>
 
+#include "depth_noise/depth_noise.h"
 #include "estimators.h"
 #include "plausibility.h"
 #include "rank_selection.h"
@@ -40,6 +41,9 @@ constexpr float kLargest = std::numeric_limits<float>::max();
 
 // Every second pixel of every second row tells the soil beyond the ground well enough.
 constexpr int kBeyondSampleStep = 2;
+// Below a third of the gate's default 10 mm the noise does not move its threshold: the
+// depth noise's quick count suffices.
+constexpr float kBeyondNoiseFloorMm = 3.0f;
 
 // Scales the median absolute deviation to the standard deviation of normal data.
 constexpr double kMadToSigma = 1.4826;
@@ -185,7 +189,7 @@ class GroundDistanceEstimator final : public Transform {
   // The soil of `roi` beyond a level ground at `distance_mm`, by quadrant around the
   // region's centre (pixel centres at +0.5).
   SoilBeyond soil_beyond(const cv::Mat& soil_mm, const cv::Rect& roi, double distance_mm) const {
-    SoilBeyond beyond = gates_.soil_beyond(soil_mm, roi);
+    SoilBeyond beyond = gates_.soil_beyond(depth_noise_mm(soil_mm, roi, kBeyondNoiseFloorMm));
     const cv::Point2d centre(roi.x + 0.5 * roi.width, roi.y + 0.5 * roi.height);
     for (int row = roi.y; row < roi.y + roi.height; row += kBeyondSampleStep) {
       const float* depth = soil_mm.ptr<float>(row);

@@ -378,10 +378,9 @@ class GroundPlaneEstimator final : public Transform {
  private:
   void measure(const Sampling& sampling, const cv::Mat& soil_mm, GroundDistance& out) const {
     const DepthCameraCalibration& camera = sampling.camera;
-    const double band_mm =
-        std::min(kBandPerNoise * depth_noise_mm(soil_mm, sampling.roi,
-                                                static_cast<float>(threshold_mm_ / kBandPerNoise)),
-                 kMaxBandPerThreshold * threshold_mm_);
+    const double noise_mm =
+        depth_noise_mm(soil_mm, sampling.roi, static_cast<float>(threshold_mm_ / kBandPerNoise));
+    const double band_mm = std::min(kBandPerNoise * noise_mm, kMaxBandPerThreshold * threshold_mm_);
     thread_local std::vector<GridPoint> grid;  // every grid pixel
     thread_local std::vector<SoilPoint> points;
     // The soil points first, without a branch (soil and residue alternate unpredictably),
@@ -436,7 +435,7 @@ class GroundPlaneEstimator final : public Transform {
     double squares = 0.0;
     double votes = 0.0;
     double inlier_votes = 0.0;
-    SoilBeyond beyond = gates_.soil_beyond(soil_mm, sampling.roi);
+    SoilBeyond beyond = gates_.soil_beyond(noise_mm);
     for (const SoilPoint& point : points) {
       votes += point.vote;
       const double residual_mm = surface->residual_mm(point);

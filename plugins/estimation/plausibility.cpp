@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "depth_noise/depth_noise.h"
 #include "soil_region.h"
 #include "tilth/error.h"
 
@@ -168,9 +167,7 @@ void PlausibilityGates::check(GroundDistance& out) const {
   }
 }
 
-SoilBeyond PlausibilityGates::soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const {
-  const float noise_mm =
-      depth_noise_mm(soil_mm, roi, static_cast<float>(soil_beyond_mm_ / kBeyondPerNoise));
+SoilBeyond PlausibilityGates::soil_beyond(double noise_mm) const {
   return SoilBeyond(std::clamp(kBeyondPerNoise * noise_mm, soil_beyond_mm_,
                                kMaxBeyondPerThreshold * soil_beyond_mm_));
 }

@@ -37,10 +37,11 @@ class PlausibilityGates {
   // Invalidates a measured, valid `out` whose distance, spread or confidence is implausible.
   void check(GroundDistance& out) const;
 
-  // What counts the soil beyond the ground in `roi` of these soil depths: deeper by
-  // soil_beyond_mm, or by three times their noise when that is more (up to three times
+  // What counts the soil beyond the ground of soil depths with `noise_mm` of noise
+  // (depth_noise_mm; a floor up to soil_beyond_mm / 3 changes nothing): deeper by
+  // soil_beyond_mm, or by three times the noise when that is more (up to three times
   // soil_beyond_mm).
-  SoilBeyond soil_beyond(const cv::Mat& soil_mm, cv::Rect roi) const;
+  SoilBeyond soil_beyond(double noise_mm) const;
   // Invalidates a valid `out` with more than max_soil_beyond of the soil beyond it on
   // every side. The estimators apply it before check(out).
   void check_soil_beyond(GroundDistance& out, const SoilBeyond& beyond) const;
