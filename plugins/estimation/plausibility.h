@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
 #include "soil_beyond.h"
