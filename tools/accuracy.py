@@ -37,10 +37,10 @@ SUMMARY_VARIANT = "field"
 
 STATIC = ["case_a", "case_b", "case_c", "case_d", "case_e", "wet_straw", "shadows",
           "low_sun", "heavy_cover", "bleached_cover", "light_soil", "chaff", "bleached_chaff",
-          "tilted", "tilted_5", "ridges", "tall_stubble", "field"]
+          "tilted", "tilted_5", "ridges", "cracked", "cracked_cover", "tall_stubble", "field"]
 COVERED = ["covered", "covered_mat", "covered_wet"]
 ON_THE_FIELD_RIG = ["case_c", "wet_straw", "low_sun", "heavy_cover", "tilted_5", "ridges",
-                    "tall_stubble", "field", "covered"]
+                    "cracked_cover", "tall_stubble", "field", "covered"]
 SMALL_STATIC = ["case_c", "wet_straw", "low_sun", "heavy_cover", "tilted_5", "ridges",
                 "tall_stubble", "covered"]
 

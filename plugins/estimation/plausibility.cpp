@@ -106,7 +106,7 @@ std::vector<ParamSpec> PlausibilityGates::params() {
           .in_unit("mm")
           .describe("soil deeper than the ground measured by more than this (or 3 times the "
                     "depth noise) lies beyond it"),
-      ParamSpec::number("max_soil_beyond", 0.02)
+      ParamSpec::number("max_soil_beyond", 0.03)
           .range(0, 1)
           .describe("more of the soil beyond the ground on every side of the measuring point "
                     "(each quadrant) is residue taken for soil: invalid; 1 = no check"),

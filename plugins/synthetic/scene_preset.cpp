@@ -90,6 +90,25 @@ void add_field_conditions(std::vector<ScenePreset>& list, const ScenePreset& bas
   ridges.straws = 150;
   list.push_back(ridges);
 
+  ScenePreset cracked = in_the_field(base, 45.0);
+  cracked.name = "cracked";
+  cracked.description =
+      "dry clay: cracks 10-20 mm deep and 8 mm wide around clods about 80 mm across, 150 "
+      "straws, 518 mm";
+  cracked.crack_mm = 20.0;
+  cracked.crack_width_mm = 8.0;
+  cracked.crack_spacing_mm = 80.0;
+  cracked.straws = 150;
+  list.push_back(cracked);
+
+  ScenePreset cracked_cover = heavy;
+  cracked_cover.name = "cracked_cover";
+  cracked_cover.description = "heavy_cover on cracked clay (the cracks of cracked), 518 mm";
+  cracked_cover.crack_mm = cracked.crack_mm;
+  cracked_cover.crack_width_mm = cracked.crack_width_mm;
+  cracked_cover.crack_spacing_mm = cracked.crack_spacing_mm;
+  list.push_back(cracked_cover);
+
   ScenePreset stubble = in_the_field(base, 40.0);
   stubble.name = "tall_stubble";
   stubble.description =

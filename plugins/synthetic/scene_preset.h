@@ -29,6 +29,11 @@ struct ScenePreset {
   std::array<double, 3> straw_bgr{0.38, 0.70, 0.82};
   double weathered_fraction = 0.0;  // the first-laid (lowest) straws: dark grey, weathered
   double relief_mm = 1.5;           // micro-relief amplitude of the soil
+  // Dry clay's cracks: a network of V-shaped cracks this deep (0: none) and this wide at
+  // the top, around clods about crack_spacing_mm across. The truth is the clods' surface.
+  double crack_mm = 0.0;
+  double crack_width_mm = 6.0;
+  double crack_spacing_mm = 80.0;
   // The ground's shape under the micro-relief, which the truth follows: slopes (about
   // the camera's x axis, farther towards +y when positive; about the y axis, farther
   // towards +x), and ridges and furrows (peak to peak, period, direction from +x).

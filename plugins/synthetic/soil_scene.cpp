@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -38,6 +40,7 @@ SoilScene::SoilScene(const ScenePreset& preset, double soil_z_mm, cv::Rect2d are
   material_ = cv::Mat(rows, cols, CV_8UC1, cv::Scalar(static_cast<int>(Material::kSoil)));
   albedo_.create(rows, cols, CV_8UC3);
   add_soil(rng);
+  if (preset.crack_mm > 0.0) add_cracks(rng);
   height_ = soil_height_.clone();
   add_stubble(rng);
   add_straws(rng);
@@ -127,6 +130,65 @@ void SoilScene::add_soil(cv::RNG& rng) {
         h += wave.amplitude * std::sin(wave.kx * x + wave.ky * y + wave.phase);
       soil_height_.at<float>(r, c) = static_cast<float>(h);
       albedo_.at<cv::Vec3b>(r, c) = to_bytes(soil * (1.0f + tint.at<float>(r, c)));
+    }
+  }
+}
+
+// Cracks along the borders of a Voronoi tessellation (clods around jittered seeds on a
+// grid of crack_spacing_mm): V-shaped, crack_mm deep at the border, to nothing
+// crack_width_mm / 2 either side of it; each crack's depth varies from half to all of it.
+void SoilScene::add_cracks(cv::RNG& rng) {
+  const double spacing = preset_.crack_spacing_mm;
+  const int across = static_cast<int>(std::ceil(area_.width / spacing)) + 2;
+  const int down = static_cast<int>(std::ceil(area_.height / spacing)) + 2;
+  struct Seed {
+    double x, y, depth;
+  };
+  std::vector<Seed> seeds;
+  for (int j = 0; j < down; ++j) {
+    for (int i = 0; i < across; ++i) {
+      seeds.push_back({area_.x + (i + rng.uniform(-0.5, 0.5)) * spacing,
+                       area_.y + (j + rng.uniform(-0.5, 0.5)) * spacing,
+                       preset_.crack_mm * rng.uniform(0.5, 1.0)});
+    }
+  }
+  const double half_width = preset_.crack_width_mm / 2;
+  for (int r = 0; r < soil_height_.rows; ++r) {
+    const double y = area_.y + (r + 0.5) * cell_mm_;
+    const int j = std::clamp(static_cast<int>(std::lround((y - area_.y) / spacing)), 0, down - 1);
+    for (int c = 0; c < soil_height_.cols; ++c) {
+      const double x = area_.x + (c + 0.5) * cell_mm_;
+      const int i =
+          std::clamp(static_cast<int>(std::lround((x - area_.x) / spacing)), 0, across - 1);
+      // Each seed lies within half a spacing of its grid point, so the two nearest lie
+      // among the 5x5 grid points around the pixel's.
+      double first = std::numeric_limits<double>::max(), second = first;
+      const Seed* nearest = nullptr;
+      const Seed* next = nullptr;
+      for (int dj = -2; dj <= 2; ++dj) {
+        for (int di = -2; di <= 2; ++di) {
+          const int jj = j + dj, ii = i + di;
+          if (jj < 0 || ii < 0 || jj >= down || ii >= across) continue;
+          const Seed& seed = seeds[static_cast<std::size_t>(jj * across + ii)];
+          const double d = std::hypot(x - seed.x, y - seed.y);
+          if (d < first) {
+            second = first;
+            next = nearest;
+            first = d;
+            nearest = &seed;
+          } else if (d < second) {
+            second = d;
+            next = &seed;
+          }
+        }
+      }
+      if (next == nullptr) continue;
+      // Distance to the border between the two clods, along the line between their seeds.
+      const double border = (second * second - first * first) /
+                            (2 * std::hypot(next->x - nearest->x, next->y - nearest->y));
+      if (border >= half_width) continue;
+      const double depth = std::min(nearest->depth, next->depth) * (1.0 - border / half_width);
+      soil_height_.at<float>(r, c) -= static_cast<float>(depth);
     }
   }
 }

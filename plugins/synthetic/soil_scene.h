@@ -44,6 +44,7 @@ class SoilScene {
   int cell_x(double x) const { return static_cast<int>(std::floor((x - area_.x) / cell_mm_)); }
   int cell_y(double y) const { return static_cast<int>(std::floor((y - area_.y) / cell_mm_)); }
   void add_soil(cv::RNG& rng);
+  void add_cracks(cv::RNG& rng);
   void add_stubble(cv::RNG& rng);
   void add_straws(cv::RNG& rng);
 

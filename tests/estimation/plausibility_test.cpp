@@ -202,7 +202,7 @@ cv::Mat straw_over_soil_gaps() {
 TEST(Plausibility, SoilBeyondTheGroundOnEverySideIsResidueTakenForSoil) {
   expect_invalid(estimate(straw_over_soil_gaps()), InvalidCause::kNotOneSurface,
                  "soil beyond the ground measured on every side: 25.0 % of the soil or more in "
-                 "each quadrant lies over 10.0 mm deeper > 2.0 % (residue taken for soil?)");
+                 "each quadrant lies over 10.0 mm deeper > 3.0 % (residue taken for soil?)");
   const GroundDistance unchecked =
       estimate(straw_over_soil_gaps(), nullptr, {{"max_soil_beyond", 1}});
   EXPECT_TRUE(unchecked.valid) << unchecked.invalid_reason;

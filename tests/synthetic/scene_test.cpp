@@ -1,6 +1,8 @@
 // The scene simulator against geometry computed independently: flat soil gives eq. 1's
 // inverse exactly before noise; the truth follows the soil layers of the moving
-// platform; frames are deterministic per seed; residue shows in the truth mask.
+// platform; frames are deterministic per seed; residue shows in the truth mask; cracks lie
+// below the soil.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -148,6 +150,41 @@ TEST_F(SceneTest, HostTimesAreWhenMadeOrTheSimulatedCaptureTimes) {
   ASSERT_EQ(made.size(), 2u);
   // 100 ms apart, give or take the difference of the two frames' noising.
   EXPECT_GT(made[1].info.host_timestamp_ns - made[0].info.host_timestamp_ns, 50'000'000);
+}
+
+// Dry clay (preset cracked): cracks 10-20 mm deep below the clods' surface, which the truth
+// keeps to. Against flat soil, without noise: soil pixels seen in the cracks lie farther
+// than the micro-relief reaches (1.5 mm, under 4 mm at its peaks), none farther than the
+// deepest crack plus the relief, along a ray at most 10 % longer than the depth off the
+// optical axis (the paper rig's corners).
+TEST_F(SceneTest, CracksLieBelowTheClodsNoDeeperThanThePresetSays) {
+  nlohmann::json params = {{"noise_mm", 0.0}, {"dropout", 0.0}, {"preset", "cracked"}};
+  const auto cracked = frames(params, 1);
+  params["preset"] = "flat";
+  const auto flat = frames(params, 1);
+  ASSERT_EQ(cracked.size(), 1u);
+  ASSERT_EQ(flat.size(), 1u);
+  const double mm_per_gray = load_calibration(kCalibration).depth.gray_to_mm;
+  const cv::Mat& truth = cracked[0].truth.residue_mask;
+  int soil = 0;
+  int in_cracks = 0;
+  double deepest_mm = 0.0;
+  for (int v = 0; v < truth.rows; ++v) {
+    for (int u = 0; u < truth.cols; ++u) {
+      if (truth.at<std::uint8_t>(v, u) != ResidueMask::kSoil) continue;
+      const double beyond_mm =
+          (cracked[0].raw.gray.at<std::uint16_t>(v, u) - flat[0].raw.gray.at<std::uint16_t>(v, u)) *
+          mm_per_gray;
+      ++soil;
+      in_cracks += beyond_mm > 5.0;
+      deepest_mm = std::max(deepest_mm, beyond_mm);
+    }
+  }
+  EXPECT_GT(in_cracks, soil / 100) << in_cracks << " of " << soil;
+  EXPECT_LT(in_cracks, soil / 5) << in_cracks << " of " << soil;
+  EXPECT_GT(deepest_mm, 15.0);
+  EXPECT_LT(deepest_mm, 1.1 * 20.0 + 4.0);
+  EXPECT_DOUBLE_EQ(*cracked[0].truth.distance_mm, 518.0);
 }
 
 TEST_F(SceneTest, BayerMosaicKeepsOneChannelPerPixel) {
