@@ -7,9 +7,10 @@ and the calibration are linked, not copied. For probing a chain's colour robustn
     python3 tools/recolor.py SOURCE DEST STEP[+STEP...]
 
 SOURCE is a recording (a folder with recording.json) or a folder of them; DEST is made
-with the same layout. The steps apply in turn to each pixel's value v in 0..1 (8 bits /
-255), per channel (per colour filter site in a Bayer mosaic), and the result is rounded
-and clipped to 8 bits:
+with the same layout; on an error it is removed again. Colour formats: bgr8 and the four
+bayer_*8 mosaics. The steps apply in turn to each pixel's value v in 0..1 (8 bits / 255),
+per channel (per colour filter site in a mosaic), and the result is rounded and clipped
+to 8 bits:
     gains=B,G,R    v * the channel's gain (a white balance, a colour cast)
     exposure=F     v * F
     vignette=F     v * (1 - F * r^2), r the distance from the centre over the half-diagonal
@@ -20,6 +21,7 @@ and clipped to 8 bits:
 import argparse
 import json
 import os
+import shutil
 import sys
 
 import cv2
@@ -31,57 +33,77 @@ def srgb(v):
     return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.power(v, 1 / 2.4) - 0.055)
 
 
+# The colour at each site of a Bayer tile, (0,0) (0,1) (1,0) (1,1), as B, G, R = 0, 1, 2.
+BAYER_TILES = {"bayer_rggb8": (2, 1, 1, 0), "bayer_bggr8": (0, 1, 1, 2),
+               "bayer_grbg8": (1, 2, 0, 1), "bayer_gbrg8": (1, 0, 2, 1)}
+FORMATS = ["bgr8", *BAYER_TILES]
+
+
 class Image:
-    """One colour image as floats 0..1, with per-channel gains for its layout."""
+    """One colour image as floats 0..1 (`values`), with per-channel gains for its layout."""
 
     def __init__(self, pixels, color_format):
-        if color_format not in ("bgr8", "bayer_rggb8"):
-            raise ValueError("colour format %s: expected bgr8 or bayer_rggb8" % color_format)
-        self.v = pixels.astype(np.float64) / 255.0
-        self.bayer = color_format == "bayer_rggb8"
+        self.values = pixels.astype(np.float64) / 255.0
+        self.tile = BAYER_TILES.get(color_format)
+
+    def sites(self):
+        """(rows, cols, channel) of each site of the Bayer tile."""
+        return [(rows, cols, self.tile[2 * rows + cols]) for rows in (0, 1) for cols in (0, 1)]
 
     def per_channel(self, bgr):
         """An array of the image's shape holding each pixel's channel's value of bgr."""
-        if not self.bayer:
+        if self.tile is None:
             return np.array(bgr, dtype=np.float64).reshape(1, 1, 3)
-        m = np.empty(self.v.shape)
-        m[0::2, 0::2] = bgr[2]
-        m[0::2, 1::2] = bgr[1]
-        m[1::2, 0::2] = bgr[1]
-        m[1::2, 1::2] = bgr[0]
-        return m
+        gains = np.empty(self.values.shape)
+        for rows, cols, channel in self.sites():
+            gains[rows::2, cols::2] = bgr[channel]
+        return gains
 
     def channel_means(self):
-        if not self.bayer:
-            return self.v.reshape(-1, 3).mean(axis=0)
-        green = (self.v[0::2, 1::2].mean() + self.v[1::2, 0::2].mean()) / 2
-        return np.array([self.v[1::2, 1::2].mean(), green, self.v[0::2, 0::2].mean()])
+        if self.tile is None:
+            return self.values.reshape(-1, 3).mean(axis=0)
+        sums, counts = np.zeros(3), np.zeros(3)
+        for rows, cols, channel in self.sites():
+            site = self.values[rows::2, cols::2]
+            sums[channel] += site.sum()
+            counts[channel] += site.size
+        return sums / counts
 
     def bytes(self):
-        return np.clip(np.rint(self.v * 255.0), 0, 255).astype(np.uint8)
+        return np.clip(np.rint(self.values * 255.0), 0, 255).astype(np.uint8)
+
+
+def number(step, value):
+    try:
+        return float(value)
+    except ValueError:
+        raise ValueError("step '%s': expected a number after '='" % step) from None
 
 
 def apply(image, step):
     name, _, value = step.partition("=")
     if name == "gains":
-        gains = [float(g) for g in value.split(",")]
+        gains = value.split(",")
         if len(gains) != 3:
-            raise ValueError("gains=%s: expected three gains, B,G,R" % value)
-        image.v = image.v * image.per_channel(gains)
+            raise ValueError("step '%s': expected three gains, B,G,R" % step)
+        image.values = image.values * image.per_channel([number(step, g) for g in gains])
     elif name == "exposure":
-        image.v = image.v * float(value)
+        image.values = image.values * number(step, value)
     elif name == "vignette":
-        h, w = image.v.shape[:2]
+        h, w = image.values.shape[:2]
         y, x = np.mgrid[0:h, 0:w]
         r2 = ((x - (w - 1) / 2) ** 2 + (y - (h - 1) / 2) ** 2) / (((w - 1) / 2) ** 2 +
                                                                   ((h - 1) / 2) ** 2)
-        falloff = 1.0 - float(value) * r2
-        image.v = image.v * (falloff[..., None] if image.v.ndim == 3 else falloff)
+        falloff = 1.0 - number(step, value) * r2
+        image.values = image.values * (falloff[..., None] if image.values.ndim == 3 else falloff)
     elif name == "grayworld" and not value:
         means = image.channel_means()
-        image.v = image.v * image.per_channel(means.mean() / means)
+        lit = means > 0  # a black channel stays black
+        gains = np.ones(3)
+        gains[lit] = means[lit].mean() / means[lit]
+        image.values = image.values * image.per_channel(gains)
     elif name == "srgb" and not value:
-        image.v = srgb(image.v)
+        image.values = srgb(image.values)
     else:
         raise ValueError("step '%s': expected gains=B,G,R, exposure=F, vignette=F, grayworld "
                          "or srgb" % step)
@@ -97,18 +119,27 @@ def recordings(source):
     return found
 
 
-def recolor(source, dest, steps):
-    with open(os.path.join(source, "recording.json")) as f:
-        color_format = json.load(f)["color_format"]
+def color_format(recording):
+    with open(os.path.join(recording, "recording.json")) as f:
+        found = json.load(f).get("color_format")
+    if found not in FORMATS:
+        raise ValueError("%s: colour format %s, expected one of %s"
+                         % (recording, found, ", ".join(FORMATS)))
+    return found
+
+
+def recolor(source, dest, layout, steps):
+    entries = os.listdir(source)
     os.makedirs(os.path.join(dest, "color"))
-    for entry in os.listdir(source):
+    for entry in entries:
         if entry != "color":
             os.symlink(os.path.abspath(os.path.join(source, entry)), os.path.join(dest, entry))
     for png in sorted(os.listdir(os.path.join(source, "color"))):
-        pixels = cv2.imread(os.path.join(source, "color", png), cv2.IMREAD_UNCHANGED)
+        path = os.path.join(source, "color", png)
+        pixels = cv2.imread(path, cv2.IMREAD_UNCHANGED)
         if pixels is None:
-            raise ValueError("%s: not an image" % os.path.join(source, "color", png))
-        image = Image(pixels, color_format)
+            raise ValueError("%s: not an image" % path)
+        image = Image(pixels, layout)
         for step in steps:
             apply(image, step)
         cv2.imwrite(os.path.join(dest, "color", png), image.bytes())
@@ -126,10 +157,17 @@ def main():
             apply(Image(np.full((2, 2, 3), 128, np.uint8), "bgr8"), step)
         if os.path.exists(args.dest):
             raise ValueError("%s exists: choose a new folder" % args.dest)
-        for name, folder in recordings(args.source):
-            recolor(folder, os.path.join(args.dest, name), steps)
+        found = [(name, folder, color_format(folder))
+                 for name, folder in recordings(args.source)]
     except (ValueError, OSError) as error:
         print("recolor.py: %s" % error, file=sys.stderr)
+        return 2
+    try:
+        for name, folder, layout in found:
+            recolor(folder, os.path.join(args.dest, name), layout, steps)
+    except (ValueError, OSError) as error:
+        shutil.rmtree(args.dest, ignore_errors=True)  # made here: nothing of the user's
+        print("recolor.py: %s (%s removed)" % (error, args.dest), file=sys.stderr)
         return 2
     return 0
 

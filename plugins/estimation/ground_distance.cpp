@@ -137,7 +137,9 @@ class GroundDistanceEstimator final : public Transform {
       out.invalidate(InvalidCause::kTooLittleSoil, std::move(shortfall));
     } else {
       measure(depths, out);
-      gates_.check_soil_beyond(out, soil_beyond(soil.mm, roi, out.distance_mm));
+      if (out.valid && gates_.checks_soil_beyond()) {
+        gates_.check_soil_beyond(out, soil_beyond(soil.mm, roi, out.distance_mm));
+      }
       gates_.check(out);
     }
     frame.set_output(0, message);

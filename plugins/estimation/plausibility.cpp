@@ -173,7 +173,7 @@ SoilBeyond PlausibilityGates::soil_beyond(double noise_mm) const {
 }
 
 void PlausibilityGates::check_soil_beyond(GroundDistance& out, const SoilBeyond& beyond) const {
-  if (!out.valid || max_soil_beyond_ >= 1.0) return;
+  if (!out.valid || !checks_soil_beyond()) return;
   const double share = beyond.least_share();
   if (share > max_soil_beyond_) {
     out.invalidate(InvalidCause::kNotOneSurface,

@@ -44,6 +44,9 @@ class PlausibilityGates {
   // Invalidates a valid `out` with more than max_soil_beyond of the soil beyond it on
   // every side. The estimators apply it before check(out).
   void check_soil_beyond(GroundDistance& out, const SoilBeyond& beyond) const;
+  // Whether check_soil_beyond can invalidate anything (max_soil_beyond under 1): where
+  // counting the soil beyond costs a pass of its own, count it only then.
+  bool checks_soil_beyond() const { return max_soil_beyond_ < 1.0; }
 
  private:
   double min_distance_mm_;

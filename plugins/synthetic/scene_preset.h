@@ -32,7 +32,7 @@ struct ScenePreset {
   // Dry clay's cracks: a network of V-shaped cracks this deep (0: none) and this wide at
   // the top, around clods about crack_spacing_mm across. The truth is the clods' surface.
   double crack_mm = 0.0;
-  double crack_width_mm = 6.0;
+  double crack_width_mm = 8.0;
   double crack_spacing_mm = 80.0;
   // The ground's shape under the micro-relief, which the truth follows: slopes (about
   // the camera's x axis, farther towards +y when positive; about the y axis, farther

@@ -160,34 +160,38 @@ void SoilScene::add_cracks(cv::RNG& rng) {
       const double x = area_.x + (c + 0.5) * cell_mm_;
       const int i =
           std::clamp(static_cast<int>(std::lround((x - area_.x) / spacing)), 0, across - 1);
-      // Each seed lies within half a spacing of its grid point, so the two nearest lie
-      // among the 5x5 grid points around the pixel's.
-      double first = std::numeric_limits<double>::max(), second = first;
-      const Seed* nearest = nullptr;
-      const Seed* next = nullptr;
-      for (int dj = -2; dj <= 2; ++dj) {
-        for (int di = -2; di <= 2; ++di) {
-          const int jj = j + dj, ii = i + di;
-          if (jj < 0 || ii < 0 || jj >= down || ii >= across) continue;
-          const Seed& seed = seeds[static_cast<std::size_t>(jj * across + ii)];
-          const double d = std::hypot(x - seed.x, y - seed.y);
-          if (d < first) {
-            second = first;
-            next = nearest;
-            first = d;
-            nearest = &seed;
-          } else if (d < second) {
-            second = d;
-            next = &seed;
-          }
+      // Each seed lies within half a spacing of its grid point: the nearest seed, and the
+      // neighbours whose borders with its clod pass near the pixel, lie among the 5x5 grid
+      // points around the pixel's.
+      std::array<const Seed*, 25> candidates{};
+      std::size_t count = 0;
+      for (int row = std::max(j - 2, 0); row <= std::min(j + 2, down - 1); ++row) {
+        for (int col = std::max(i - 2, 0); col <= std::min(i + 2, across - 1); ++col) {
+          candidates[count++] = &seeds[static_cast<std::size_t>(row * across + col)];
         }
       }
-      if (next == nullptr) continue;
-      // Distance to the border between the two clods, along the line between their seeds.
-      const double border = (second * second - first * first) /
-                            (2 * std::hypot(next->x - nearest->x, next->y - nearest->y));
+      const auto squared_distance = [&](const Seed* seed) {
+        return (x - seed->x) * (x - seed->x) + (y - seed->y) * (y - seed->y);
+      };
+      const Seed* nearest = *std::min_element(
+          candidates.begin(), candidates.begin() + count,
+          [&](const Seed* a, const Seed* b) { return squared_distance(a) < squared_distance(b); });
+      // The nearest border of its clod: the pixel's distance to the bisector between the
+      // nearest seed and each other.
+      double border = std::numeric_limits<double>::max();
+      double depth = 0.0;
+      for (std::size_t k = 0; k < count; ++k) {
+        const Seed* other = candidates[k];
+        if (other == nearest) continue;
+        const double to_bisector = (squared_distance(other) - squared_distance(nearest)) /
+                                   (2 * std::hypot(other->x - nearest->x, other->y - nearest->y));
+        if (to_bisector < border) {
+          border = to_bisector;
+          depth = std::min(nearest->depth, other->depth);
+        }
+      }
       if (border >= half_width) continue;
-      const double depth = std::min(nearest->depth, next->depth) * (1.0 - border / half_width);
+      depth *= 1.0 - border / half_width;
       soil_height_.at<float>(r, c) -= static_cast<float>(depth);
     }
   }

@@ -245,6 +245,31 @@ TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
   EXPECT_NEAR(unchecked.distance_mm, 500.0, 0.01);
 }
 
+// Cracked clay: crack bottoms are soil beyond the ground on every side too. On the cracked
+// presets up to 2.5 % of the soil in each quadrant lay beyond the clods (docs/estimation.md,
+// "Cracks are soil beyond the ground too"): here 2.5 % of the pixels, at random, 30 mm
+// beyond. Valid at the default, 3 %; invalid at the gate's first setting, 2 %.
+TEST(Plausibility, CracksShowingUnderThreePercentOfTheSoilBeyondAreNoResidue) {
+  cv::Mat cracks = flat_soil(500.0f);
+  cv::Mat chance(cracks.size(), CV_32FC1);
+  cv::RNG(16).fill(chance, cv::RNG::UNIFORM, 0.0f, 1.0f);
+  cracks.setTo(530.0, chance < 0.025f);
+  const auto run = [&](const json& params) {
+    json all = params;
+    all["calibration"] = kPaperRig.string();
+    TransformHarness plane(describe_ground_plane(), all);
+    return plane.run({depth_message(cracks), nullptr})[0].get<GroundDistance>();
+  };
+  const GroundDistance out = run(json::object());
+  EXPECT_TRUE(out.valid) << out.invalid_reason;
+  EXPECT_NEAR(out.distance_mm, 500.0, 0.01);
+  const GroundDistance at_two_percent = run({{"max_soil_beyond", 0.02}});
+  EXPECT_FALSE(at_two_percent.valid);
+  const std::string expected = "soil beyond the ground measured on every side: 2.";
+  EXPECT_EQ(at_two_percent.invalid_reason.substr(0, expected.size()), expected)
+      << at_two_percent.invalid_reason;
+}
+
 // A step beside an off-axis tool point: the tool 110 mm down the image (row 352 at
 // 500 mm on the paper's rig, fy 510), so the quadrants below it hold 7 of the region's 240
 // rows (3 %, under SoilBeyond::kMinQuadrantShare), and the ground 30 mm deeper over the

@@ -1,6 +1,8 @@
 """tools/recolor.py against values computed here: a colour cast, exposure and the sRGB
 curve on a bgr8 and a Bayer recording made by `tilth simulate`; depth and truth linked,
-not copied; a bad step or an existing destination refused before anything is written."""
+not copied; a BGGR mosaic's sites; a bad step or an existing destination refused before
+anything is written, and an unreadable image leaving no destination behind."""
+import json
 import os
 import shutil
 import subprocess
@@ -65,6 +67,33 @@ class Recolor(unittest.TestCase):
             np.testing.assert_array_equal(after[rows::2, cols::2],
                                           self.expected(before[rows::2, cols::2], gain))
 
+    def test_a_bggr_mosaic_has_blue_where_rggb_has_red(self):
+        bggr = os.path.join(self.tmp, "bggr")
+        shutil.copytree(os.path.join(self.source, "bayer"), bggr)
+        with open(os.path.join(bggr, "recording.json")) as f:
+            recording = json.load(f)
+        recording["color_format"] = "bayer_bggr8"
+        with open(os.path.join(bggr, "recording.json"), "w") as f:
+            json.dump(recording, f)
+        dest = os.path.join(self.tmp, "bggr-blue")
+        self.assertEqual(recolor(bggr, dest, "gains=2,1,1").returncode, 0)
+        before = cv2.imread(os.path.join(bggr, "color", "000000.png"), cv2.IMREAD_UNCHANGED)
+        after = cv2.imread(os.path.join(dest, "color", "000000.png"), cv2.IMREAD_UNCHANGED)
+        np.testing.assert_array_equal(after[0::2, 0::2],
+                                      np.clip(before[0::2, 0::2].astype(int) * 2, 0, 255))
+        np.testing.assert_array_equal(after[1::2, 1::2], before[1::2, 1::2])
+
+    def test_an_unreadable_image_leaves_no_destination(self):
+        broken = os.path.join(self.tmp, "broken")
+        shutil.copytree(os.path.join(self.source, "bgr"), broken)
+        with open(os.path.join(broken, "color", "000001.png"), "w") as f:
+            f.write("not a png")
+        dest = os.path.join(self.tmp, "broken-warm")
+        result = recolor(broken, dest, "srgb")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("000001.png: not an image", result.stderr)
+        self.assertFalse(os.path.exists(dest))
+
     def test_depth_truth_and_calibration_are_the_sources(self):
         for entry in ("depth", "mask", "recording.json", "rig.calib.json"):
             path = os.path.join(self.dest, "bgr", entry)
@@ -76,7 +105,7 @@ class Recolor(unittest.TestCase):
         dest = os.path.join(self.tmp, "bad")
         result = recolor(self.source, dest, "gains=1,1+srgb")
         self.assertEqual(result.returncode, 2)
-        self.assertIn("gains=1,1: expected three gains", result.stderr)
+        self.assertIn("step 'gains=1,1': expected three gains", result.stderr)
         self.assertFalse(os.path.exists(dest))
         result = recolor(self.source, self.dest, "srgb")
         self.assertEqual(result.returncode, 2)
