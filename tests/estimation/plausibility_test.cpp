@@ -246,7 +246,7 @@ TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
 }
 
 // Cracked clay: crack bottoms are soil beyond the ground on every side too. On the cracked
-// presets up to 2.5 % of the soil in each quadrant lay beyond the clods (docs/estimation.md,
+// presets up to 2.7 % of the soil in each quadrant lay beyond the clods (docs/estimation.md,
 // "Cracks are soil beyond the ground too"): here 2.5 % of the pixels, at random, 30 mm
 // beyond. Valid at the default, 3 %; invalid at the gate's first setting, 2 %.
 TEST(Plausibility, CracksShowingUnderThreePercentOfTheSoilBeyondAreNoResidue) {
