@@ -331,6 +331,7 @@ class GroundPlaneEstimator final : public Transform {
         neighbourhood_mm_(context.params.number("neighbourhood_mm")),
         tool_area_mm_(context.params.number("tool_area_mm")),
         min_inlier_fraction_(context.params.number("min_inlier_fraction")),
+        min_surrounding_fraction_(context.params.number("min_surrounding_fraction")),
         min_step_mm_(context.params.number("min_step_mm")),
         gates_(context.params),
         calibration_(
@@ -431,6 +432,7 @@ class GroundPlaneEstimator final : public Transform {
       return;
     }
 
+    double weight = 0.0;
     double inlier_weight = 0.0;
     double squares = 0.0;
     double votes = 0.0;
@@ -438,6 +440,7 @@ class GroundPlaneEstimator final : public Transform {
     SoilBeyond beyond = gates_.soil_beyond(noise_mm);
     for (const SoilPoint& point : points) {
       votes += point.vote;
+      weight += point.weight;
       const double residual_mm = surface->residual_mm(point);
       beyond.add(point.x - tool_point_mm_[0], point.y - tool_point_mm_[1], residual_mm,
                  point.weight);
@@ -452,6 +455,21 @@ class GroundPlaneEstimator final : public Transform {
                      "no surface fits the soil: " + one_decimal(100.0 * inlier_fraction) +
                          " % of the soil points (by weight) lie within " + one_decimal(band_mm) +
                          " mm of the tool's < " + one_decimal(100.0 * min_inlier_fraction_) + " %");
+      return;
+    }
+    // A tool is wider than a crack or a hole and rests on the ground around it: a level
+    // voted from the soil in one (heavy cover leaves little else in view near the tool)
+    // holds a minority of the soil around the tool.
+    if (const double surrounding = inlier_weight / weight;
+        surrounding < min_surrounding_fraction_) {
+      out.invalidate(InvalidCause::kNotOneSurface,
+                     "the tool's surface holds too little of the soil around it: " +
+                         one_decimal(100.0 * surrounding) +
+                         " % of the soil points (by "
+                         "nearness) lie within " +
+                         one_decimal(band_mm) + " mm of it < " +
+                         one_decimal(100.0 * min_surrounding_fraction_) +
+                         " % (the tool point over a crack or a hole?)");
       return;
     }
     const double depth_at_tool = surface->depth_at_origin();
@@ -533,6 +551,7 @@ class GroundPlaneEstimator final : public Transform {
   const double neighbourhood_mm_;
   const double tool_area_mm_;
   const double min_inlier_fraction_;
+  const double min_surrounding_fraction_;
   const double min_step_mm_;
   const PlausibilityGates gates_;
   FrameCalibration<Sampling> calibration_;
@@ -576,6 +595,11 @@ StageDescriptor describe_ground_plane() {
           .range(0, 1)
           .describe("below this fraction of the soil points (weighed by their votes) on the "
                     "tool's surface the measurement is invalid"),
+      ParamSpec::number("min_surrounding_fraction", 0.5)
+          .range(0, 1)
+          .describe("below this fraction of the soil points around the tool (weighed by "
+                    "nearness, neighbourhood_mm) on the tool's surface the measurement is "
+                    "invalid: the level came from a crack or a hole under the tool point"),
       ParamSpec::number("min_step_mm", 0.0)
           .range(0, 16)
           .in_unit("mm")
