@@ -465,10 +465,8 @@ class GroundPlaneEstimator final : public Transform {
       out.invalidate(InvalidCause::kNotOneSurface,
                      "the tool's surface holds too little of the soil around it: " +
                          one_decimal(100.0 * surrounding) +
-                         " % of the soil points (by "
-                         "nearness) lie within " +
-                         one_decimal(band_mm) + " mm of it < " +
-                         one_decimal(100.0 * min_surrounding_fraction_) +
+                         " % of the soil points (by nearness) lie within " + one_decimal(band_mm) +
+                         " mm of it < " + one_decimal(100.0 * min_surrounding_fraction_) +
                          " % (the tool point over a crack or a hole?)");
       return;
     }
