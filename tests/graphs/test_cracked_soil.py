@@ -12,12 +12,15 @@ is a crack's slope, and the ground fitted on its level read 3.5 mm far, valid. T
 surface now has to hold most of the soil around the tool (min_surrounding_fraction): that
 frame is invalid, and without the rule it is the wrong valid distance again.
 """
-import json
 import os
 import shutil
-import subprocess
+import sys
 import tempfile
 import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "support"))
+from simulated_ab import compare, frames_of, simulate  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 SOURCE = os.environ["TILTH_SOURCE_DIR"]
@@ -25,44 +28,30 @@ FRAMES = 4
 SOIL_BEYOND = "soil beyond the ground measured on every side"
 
 
-def frames_of(report, variant, recording="cracked"):
-    path = os.path.join(report, "runs", variant, recording, "frames.jsonl")
-    with open(path) as f:
-        return [json.loads(line) for line in f]
-
-
 class CrackedSoil(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="tilth-cracked-soil-")
-        recording = os.path.join(cls.tmp, "cracked")
-        result = subprocess.run(
-            [TILTH, "simulate", recording, "--preset", "cracked", "--frames", str(FRAMES),
-             "--calibration", os.path.join(SOURCE, "calib", "field_rig.calib.json"),
-             "--color-format", "bayer_rggb8"],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
-        cls.report = os.path.join(cls.tmp, "report")
-        result = subprocess.run(
-            [TILTH, "ab", recording, "--out", cls.report, "--overlays", "0", "--quiet",
-             "--variant", "shipped",
-             "--variant", "at_2_percent:estimate.max_soil_beyond=0.02"],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
+        recording = simulate(
+            TILTH, os.path.join(cls.tmp, "cracked"), "cracked", "--frames", str(FRAMES),
+            "--calibration", os.path.join(SOURCE, "calib", "field_rig.calib.json"),
+            "--color-format", "bayer_rggb8")
+        cls.report = compare(TILTH, recording, os.path.join(cls.tmp, "report"), "shipped",
+                             "at_2_percent:estimate.max_soil_beyond=0.02")
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
     def test_every_frame_is_valid_and_within_the_bounds(self):
-        frames = frames_of(self.report, "shipped")
+        frames = frames_of(self.report, "shipped", "cracked")
         self.assertEqual(len(frames), FRAMES)
         for frame in frames:
             self.assertTrue(frame["valid"], frame["invalid_reason"])
             self.assertLess(abs(frame["distance_mm"] - frame["truth_mm"]), 1.5, frame)
 
     def test_at_two_percent_the_cracks_looked_like_residue_taken_for_soil(self):
-        reasons = [frame["invalid_reason"] for frame in frames_of(self.report, "at_2_percent")]
+        reasons = [frame["invalid_reason"] for frame in frames_of(self.report, "at_2_percent", "cracked")]
         self.assertTrue(any(reason.startswith(SOIL_BEYOND) for reason in reasons), reasons)
 
 
@@ -70,19 +59,10 @@ class ACrackUnderTheTool(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="tilth-crack-under-the-tool-")
-        recording = os.path.join(cls.tmp, "cracked_cover")
-        result = subprocess.run(
-            [TILTH, "simulate", recording, "--preset", "cracked_cover", "--frames", "1",
-             "--seed", "3"],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
-        cls.report = os.path.join(cls.tmp, "report")
-        result = subprocess.run(
-            [TILTH, "ab", recording, "--out", cls.report, "--overlays", "0", "--quiet",
-             "--variant", "shipped",
-             "--variant", "unchecked:estimate.min_surrounding_fraction=0"],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
+        recording = simulate(TILTH, os.path.join(cls.tmp, "cracked_cover"), "cracked_cover",
+                             "--frames", "1", "--seed", "3")
+        cls.report = compare(TILTH, recording, os.path.join(cls.tmp, "report"), "shipped",
+                             "unchecked:estimate.min_surrounding_fraction=0")
 
     @classmethod
     def tearDownClass(cls):

@@ -2,66 +2,70 @@
 through the measurement chain with a colour index alone for segmentation (the variant
 color_index of graphs/ab/segmentation-variants.json). The straw's colour lies within the
 soil's, Otsu's split takes a layer of straw for soil, and the soil seen in its gaps lies
-about 30 mm beyond it. The plausibility gate "soil beyond the ground on every side"
-(docs/estimation.md) must leave no such frame valid; without it (max_soil_beyond 1) some
-are valid and over 20 mm short, so the test can fail.
+about 30 mm beyond it. Two rules of docs/estimation.md catch such frames, each alone:
+the plausibility gate "soil beyond the ground on every side" (rule 4) and
+ground_plane's "the tool's surface holds too little of the soil around it" (rule 3d).
+With either, and with both (the chain as configured), no frame may be valid and wrong;
+without both (max_soil_beyond 1, min_surrounding_fraction 0) some are valid and over 20 mm
+short, so the test can fail.
 """
-import json
 import os
 import shutil
-import subprocess
+import sys
 import tempfile
 import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "support"))
+from simulated_ab import compare, frames_of, simulate  # noqa: E402
 
 TILTH = os.environ["TILTH_BIN"]
 FRAMES = 4
 COLOR_INDEX = "segment.type=segmentation.color_index"
-
-
-def frames_of(report, variant):
-    path = os.path.join(report, "runs", variant, "bleached_cover", "frames.jsonl")
-    with open(path) as f:
-        return [json.loads(line) for line in f]
+WITHOUT_GATE = "estimate.max_soil_beyond=1"
+WITHOUT_RULE_3D = "estimate.min_surrounding_fraction=0"
 
 
 class ResidueTakenForSoil(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="tilth-residue-as-soil-")
-        recording = os.path.join(cls.tmp, "bleached_cover")
-        result = subprocess.run(
-            [TILTH, "simulate", recording, "--preset", "bleached_cover", "--frames", str(FRAMES)],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
-        cls.report = os.path.join(cls.tmp, "report")
-        result = subprocess.run(
-            [TILTH, "ab", recording, "--out", cls.report, "--overlays", "0", "--quiet",
-             "--variant", "gated:" + COLOR_INDEX,
-             "--variant", "ungated:" + COLOR_INDEX,
-             "--variant", "ungated:estimate.max_soil_beyond=1"],
-            capture_output=True, text=True, timeout=300)
-        assert result.returncode == 0, result.stderr[-2000:]
+        recording = simulate(TILTH, os.path.join(cls.tmp, "bleached_cover"), "bleached_cover",
+                             "--frames", str(FRAMES))
+        variants = {"both": [], "gate": [WITHOUT_RULE_3D], "rule_3d": [WITHOUT_GATE],
+                    "neither": [WITHOUT_GATE, WITHOUT_RULE_3D]}
+        cls.report = compare(TILTH, recording, os.path.join(cls.tmp, "report"),
+                             *[name + ":" + setting for name, settings in variants.items()
+                               for setting in [COLOR_INDEX, *settings]])
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def test_no_frame_is_valid_and_wrong(self):
-        frames = frames_of(self.report, "gated")
+    def assert_none_valid_and_wrong(self, variant, reason):
+        frames = frames_of(self.report, variant, "bleached_cover")
         self.assertEqual(len(frames), FRAMES)
         for frame in frames:  # a frame left valid must be within issue #15's 1.5 mm
             if frame["valid"]:
                 self.assertLess(abs(frame["distance_mm"] - frame["truth_mm"]), 1.5, frame)
         reasons = [frame["invalid_reason"] for frame in frames if not frame["valid"]]
-        self.assertTrue(any(reason.startswith("soil beyond the ground measured on every side")
-                            for reason in reasons), reasons)
+        self.assertTrue(any(found.startswith(reason) for found in reasons), reasons)
 
-    def test_without_the_gate_straw_is_measured_as_soil(self):
-        frames = frames_of(self.report, "ungated")
+    def test_the_soil_beyond_gate_alone_leaves_no_frame_valid_and_wrong(self):
+        self.assert_none_valid_and_wrong("gate", "soil beyond the ground measured on every side")
+
+    def test_rule_3d_alone_leaves_no_frame_valid_and_wrong(self):
+        self.assert_none_valid_and_wrong("rule_3d",
+                                         "the tool's surface holds too little of the soil")
+
+    def test_the_chain_as_configured_leaves_no_frame_valid_and_wrong(self):
+        self.assert_none_valid_and_wrong("both", "")
+
+    def test_without_both_straw_is_measured_as_soil(self):
+        frames = frames_of(self.report, "neither", "bleached_cover")
         self.assertEqual(len(frames), FRAMES)
         errors = [frame["distance_mm"] - frame["truth_mm"] for frame in frames if frame["valid"]]
         self.assertTrue(any(error < -20.0 for error in errors), errors)
-
 
 if __name__ == "__main__":
     unittest.main()
