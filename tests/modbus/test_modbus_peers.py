@@ -81,6 +81,20 @@ class TilthRun:
             return {int(row["index"]): row for row in csv.DictReader(f)
                     if row["truth_mm"] is not None}
 
+    def wait_running(self, timeout=60):
+        """Until Tilth says it runs the graph (its stop handlers are in place from its first
+        line on): under ASan on a loaded machine a start takes seconds, and a SIGTERM before
+        the handlers are installed kills it (-15) instead of stopping it."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and self.process.poll() is None:
+            with open(self.stderr_path) as f:
+                if "run: running " in f.read():
+                    return
+            time.sleep(0.02)
+        code, log = self.stop()
+        raise AssertionError("tilth did not start running the graph within %d s (exit %s): %s"
+                             % (timeout, code, log[-2000:]))
+
     def stop(self):
         """SIGTERM; returns the exit code and what was logged."""
         if self.process.poll() is None:
@@ -739,6 +753,7 @@ class ClientMode(unittest.TestCase):
                 {"frames": 0, "fps": 50, "first_frame_id": 1000, "invalid_every": INVALID_EVERY})
             plc = None
             try:
+                run.wait_running()
                 time.sleep(0.3)  # Tilth runs before the PLC is up
                 plc = self.start_plc()
                 first = self.wait_for_writes(timeout=4)
@@ -777,6 +792,7 @@ class ClientMode(unittest.TestCase):
                     tmp, {"mode": "client", "address": "127.0.0.1", "port": self.port,
                           "base_register": 195, "write_interval_ms": 20},
                     {"frames": 0, "fps": 50})
+                run.wait_running()
                 time.sleep(0.5)
                 code, log = run.stop()
         finally:
