@@ -222,19 +222,26 @@ TEST(Plausibility, SoilBeyondTheGroundOnOneSideIsAStep) {
   EXPECT_EQ(out.distance_mm, 500.0);
 }
 
+// Flat soil at 500 mm with `share` of its pixels, at random (`seed`), 30 mm deeper.
+cv::Mat soil_with_deeper_pixels(float share, int seed) {
+  cv::Mat depth = flat_soil(500.0f);
+  cv::Mat chance(depth.size(), CV_32FC1);
+  cv::RNG(seed).fill(chance, cv::RNG::UNIFORM, 0.0f, 1.0f);
+  depth.setTo(530.0, chance < share);
+  return depth;
+}
+
+GroundDistance fit_ground_plane(const cv::Mat& soil_mm, json params) {
+  params["calibration"] = kPaperRig.string();
+  TransformHarness plane(describe_ground_plane(), params);
+  return plane.run({depth_message(soil_mm), nullptr})[0].get<GroundDistance>();
+}
+
 // The plane estimator counts the soil points of its fit, around its tool point: a tenth of
 // the pixels, at random, 30 mm beyond the ground.
 TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
-  cv::Mat gaps = flat_soil(500.0f);
-  cv::Mat chance(gaps.size(), CV_32FC1);
-  cv::RNG(15).fill(chance, cv::RNG::UNIFORM, 0.0f, 1.0f);
-  gaps.setTo(530.0, chance < 0.1f);
-  const auto run = [&](const json& params) {
-    json all = params;
-    all["calibration"] = kPaperRig.string();
-    TransformHarness plane(describe_ground_plane(), all);
-    return plane.run({depth_message(gaps), nullptr})[0].get<GroundDistance>();
-  };
+  const cv::Mat gaps = soil_with_deeper_pixels(0.1f, 15);
+  const auto run = [&](const json& params) { return fit_ground_plane(gaps, params); };
   const GroundDistance out = run(json::object());
   EXPECT_FALSE(out.valid);
   EXPECT_EQ(out.cause, InvalidCause::kNotOneSurface);
@@ -250,16 +257,8 @@ TEST(Plausibility, ThePlaneEstimatorFindsSoilBeyondTheGroundToo) {
 // "Cracks are soil beyond the ground too"): here 2.5 % of the pixels, at random, 30 mm
 // beyond. Valid at the default, 3 %; invalid at the gate's first setting, 2 %.
 TEST(Plausibility, CracksShowingUnderThreePercentOfTheSoilBeyondAreNoResidue) {
-  cv::Mat cracks = flat_soil(500.0f);
-  cv::Mat chance(cracks.size(), CV_32FC1);
-  cv::RNG(16).fill(chance, cv::RNG::UNIFORM, 0.0f, 1.0f);
-  cracks.setTo(530.0, chance < 0.025f);
-  const auto run = [&](const json& params) {
-    json all = params;
-    all["calibration"] = kPaperRig.string();
-    TransformHarness plane(describe_ground_plane(), all);
-    return plane.run({depth_message(cracks), nullptr})[0].get<GroundDistance>();
-  };
+  const cv::Mat cracks = soil_with_deeper_pixels(0.025f, 16);
+  const auto run = [&](const json& params) { return fit_ground_plane(cracks, params); };
   const GroundDistance out = run(json::object());
   EXPECT_TRUE(out.valid) << out.invalid_reason;
   EXPECT_NEAR(out.distance_mm, 500.0, 0.01);
