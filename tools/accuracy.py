@@ -13,6 +13,11 @@ out of the error (the truth itself jumps there) and counted apart.
     python3 tools/accuracy.py > docs/accuracy.md            # the whole matrix
     python3 tools/accuracy.py --small --check field         # what CI runs (tests/CMakeLists.txt)
 
+    python3 tools/accuracy.py --random 40 --seed 7 --field-only  # scenes drawn at random
+
+--random N draws N scenes from the ranges a field has (random_scene below: soils, straw,
+cover, stubble, light, ground shape, cracks, ToF noise, rig and colour format), each a
+preset with its fields changed (`tilth simulate --scene`), instead of the named presets.
 --check VARIANT exits 1 unless that variant meets the bounds of docs/accuracy.md on every
 scenario. TILTH=path/to/tilth uses another build. --recordings DIR keeps the simulated
 recordings there and reuses them on the next run (to compare variants without rendering again).
@@ -22,6 +27,7 @@ import csv
 import json
 import math
 import os
+import random
 import statistics
 import subprocess
 import sys
@@ -53,19 +59,101 @@ NO_SOIL = 0.01        # under this: the frame must be invalid
 
 
 class Scenario:
-    def __init__(self, preset, rig="paper", color_format="bgr8", frames=None):
+    def __init__(self, preset, rig="paper", color_format="bgr8", frames=None, scene=None,
+                 name=None, noise=()):
         self.preset = preset
         self.rig = rig
         self.color_format = color_format
         self.frames = frames
+        self.scene = scene  # fields of the preset changed (tilth simulate --scene)
+        self.noise = list(noise)  # the scenario's own sensor noise options
         # as tilth ab names the recording of its folder
-        self.name = preset if rig == "paper" else "%s_%s_rig" % (preset, rig)
+        self.name = name or (preset if rig == "paper" else "%s_%s_rig" % (preset, rig))
 
     def simulate(self, tilth, folder, frames, seed, noise):
         command = [tilth, "simulate", folder, "--preset", self.preset,
                    "--frames", str(self.frames or frames), "--calibration", RIGS[self.rig],
-                   "--color-format", self.color_format, "--seed", str(seed), *noise]
+                   "--color-format", self.color_format, "--seed", str(seed),
+                   *(self.noise or noise)]
+        if self.scene:
+            command += ["--scene", json.dumps(self.scene)]
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+
+    def described(self):
+        """What the scene is, in one line: its rig, format, noise and changed fields."""
+        text = "%s rig, %s" % (self.rig, self.color_format)
+        if self.noise:
+            text += ", " + " ".join(self.noise)
+        if self.scene:
+            text += ", `%s`" % json.dumps(self.scene)
+        return text
+
+
+# Soils from near black to pale sand and red (reflectance B, G, R), and straw from fresh
+# beige-yellow to sun-bleached grey: the ends of what docs/simulator.md's presets hold,
+# and colours between them.
+SOILS = [(0.16, 0.23, 0.32), (0.08, 0.10, 0.13), (0.30, 0.42, 0.52), (0.12, 0.18, 0.38),
+         (0.22, 0.25, 0.28)]
+FRESH_STRAW = (0.38, 0.70, 0.82)
+BLEACHED_STRAW = (0.58, 0.74, 0.80)
+FIELD_SKY = (0.42, 0.34, 0.27)
+
+
+def random_scene(draw):
+    """A scene a field could show: every field of the preset drawn from its range."""
+    def rounded(values, digits=3):
+        return [round(v, digits) for v in values]
+
+    soil = draw.choice(SOILS)
+    shade = draw.uniform(0.85, 1.15)
+    bleached = draw.random()
+    brightness = draw.uniform(0.8, 1.1)
+    straw = [brightness * (f + bleached * (b - f)) for f, b in zip(FRESH_STRAW, BLEACHED_STRAW)]
+    sky = draw.uniform(0.8, 1.2)
+    height = draw.uniform(40, 120)
+    scene = {
+        "ground_distance_mm": round(draw.uniform(450, 650), 1),
+        "stubble": draw.randrange(0, 301),
+        "stubble_height_mm": round(height, 1),
+        "stubble_height_spread_mm": round(draw.uniform(0, min(40, height)), 1),
+        "straws": draw.randrange(0, 601),
+        "straw_length_mm": [round(draw.uniform(40, 100)), round(draw.uniform(150, 300))],
+        "straw_radius_mm": rounded([draw.uniform(1.0, 2.0), draw.uniform(2.0, 3.5)], 2),
+        "wet_straw": draw.random() < 0.1,
+        "soil_bgr": rounded([min(1.0, shade * c) for c in soil]),
+        "straw_bgr": rounded([min(1.0, c) for c in straw]),
+        "weathered_fraction": round(draw.uniform(0, 0.6), 2),
+        "relief_mm": round(draw.uniform(0.5, 4.0), 2),
+        "tilt_x_deg": round(draw.uniform(-5, 5), 2),
+        "tilt_y_deg": round(draw.uniform(-5, 5), 2),
+        "sun_elevation_deg": round(draw.uniform(20, 70), 1),
+        "sun_azimuth_deg": round(draw.uniform(-180, 180), 1),
+        "sky_bgr": rounded([sky * c for c in FIELD_SKY]),
+        "reflectivity_noise": True,
+        "multipath": round(draw.uniform(0, 0.03), 3),
+    }
+    if draw.random() < 0.25:
+        scene.update({"crack_mm": round(draw.uniform(5, 20), 1),
+                      "crack_width_mm": round(draw.uniform(4, 10), 1),
+                      "crack_spacing_mm": round(draw.uniform(60, 150))})
+    if draw.random() < 0.25:
+        scene.update({"ridge_mm": round(draw.uniform(5, 25), 1),
+                      "ridge_period_mm": round(draw.uniform(400, 900)),
+                      "ridge_angle_deg": round(draw.uniform(0, 180))})
+    return scene
+
+
+def random_scenarios(count, seed):
+    draw = random.Random(seed)
+    listed = []
+    for index in range(count):
+        rig = draw.choice(sorted(RIGS))
+        color_format = draw.choice(["bgr8", "bayer_rggb8"])
+        noise = ["--tof-noise", "%.2f" % draw.uniform(0.7, 2.0),
+                 "--color-noise", "%.1f" % draw.uniform(1.0, 6.0)]
+        listed.append(Scenario("case_a", rig, color_format, scene=random_scene(draw),
+                               name="random_%03d" % (index + 1), noise=noise))
+    return listed
 
 
 def scenarios(small, frames):
@@ -144,7 +232,8 @@ def noise_options(args):
 
 
 def run_matrix(args, work):
-    listed = scenarios(args.small, args.frames)
+    listed = (random_scenarios(args.random, args.seed) if args.random
+              else scenarios(args.small, args.frames))
     folders = []
     for scenario in listed:
         folder = os.path.join(args.recordings or work, scenario.name)
@@ -153,7 +242,8 @@ def run_matrix(args, work):
             scenario.simulate(args.tilth, folder, args.frames, args.seed, noise_options(args))
         folders.append(folder)
     report = os.path.join(work, "ab")
-    subprocess.run([args.tilth, "ab", *folders, "--variants", args.variants, "--out", report,
+    chosen = ["--variant", SUMMARY_VARIANT] if args.field_only else ["--variants", args.variants]
+    subprocess.run([args.tilth, "ab", *folders, *chosen, "--out", report,
                     "--overlays", "0", "--quiet", "--jobs", str(args.jobs)], check=True)
     with open(os.path.join(report, "summary.json")) as f:
         variants = [v["name"] for v in json.load(f)["variants"]]
@@ -165,7 +255,7 @@ def run_matrix(args, work):
     return listed, variants, cells
 
 
-def print_report(args, listed, variants, cells):
+def print_matrix_intro(args):
     print("# Accuracy on simulated field scenarios\n")
     options = (" --small" if args.small else "") + (
         " --frames %d" % args.frames if args.frames != (3 if args.small else 8) else "")
@@ -190,6 +280,23 @@ def print_report(args, listed, variants, cells):
     print("least %d %% visible soil invalid (missed). Visible soil is the truth mask's soil"
           % (VISIBLE_SOIL * 100))
     print("over the whole depth image.\n")
+
+
+def print_random_intro(args):
+    print("# Accuracy on scenes drawn at random\n")
+    print("Produced by `python3 tools/accuracy.py --random %d --seed %d%s`: %d scenes drawn"
+          % (args.random, args.seed, " --frames %d" % args.frames if args.frames != 8 else "",
+             args.random))
+    print("from the ranges a field has (`random_scene` in the script; the scenes are listed")
+    print("at the end), %d frames each. Errors, bounds and columns as in docs/accuracy.md.\n"
+          % args.frames)
+
+
+def print_report(args, listed, variants, cells):
+    if args.random:
+        print_random_intro(args)
+    else:
+        print_matrix_intro(args)
     print("## `%s`\n" % SUMMARY_VARIANT)
     print("| scenario | frames | valid | missed | false valid | mean (mm) | std (mm) "
           "| max abs (mm) | step frames |")
@@ -219,6 +326,10 @@ def print_report(args, listed, variants, cells):
                 text += ", **%d false valid**" % cell.false_valid
             row.append(text)
         print("| %s | %s |" % (scenario.name, " | ".join(row)))
+    if args.random:
+        print("\n## The scenes\n")
+        for scenario in listed:
+            print("- %s: %s" % (scenario.name, scenario.described()))
 
 
 def main():
@@ -236,7 +347,12 @@ def main():
     parser.add_argument("--color-noise", type=float, metavar="DN",
                         help="the colour camera's noise (the simulator's: 2); keep the "
                              "recordings apart")
+    parser.add_argument("--random", type=int, metavar="N",
+                        help="N scenes drawn at random from a field's ranges (seeded by --seed) "
+                             "instead of the presets")
     parser.add_argument("--variants", default=VARIANTS)
+    parser.add_argument("--field-only", action="store_true",
+                        help="run only the chain as it is (%s), not every variant" % SUMMARY_VARIANT)
     parser.add_argument("--recordings", metavar="DIR",
                         help="keep the simulated recordings here, and reuse those already here")
     parser.add_argument("--jobs", type=int, default=2)

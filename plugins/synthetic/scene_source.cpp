@@ -18,6 +18,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "camera_geometry/lens_model.h"
+#include "preset_changes.h"
 #include "ray_caster.h"
 #include "scene_preset.h"
 #include "tilth/calibration.h"
@@ -79,7 +80,8 @@ class SceneSource final : public Source {
   explicit SceneSource(const StageContext& context)
       : rig_(load_calibration(context.params.path("calibration"))),
         carried_rig_(std::make_shared<const RigCalibration>(rig_)),
-        preset_(scene_preset(context.params.string("preset"))),
+        preset_(changed_preset(scene_preset(context.params.string("preset")),
+                               context.params.json("scene"))),
         lighting_(preset_),
         seed_(static_cast<std::uint64_t>(context.params.integer("seed"))),
         frames_(context.params.integer("frames") > 0 ? context.params.integer("frames")
@@ -324,6 +326,9 @@ StageDescriptor describe() {
   d.params = {
       ParamSpec::path("calibration", std::nullopt).describe("rig calibration: both cameras' poses"),
       ParamSpec::choice("preset", scene_preset_names(), "case_c").describe("scene preset"),
+      ParamSpec::json("scene", nlohmann::json::object())
+          .describe("fields of the preset to change, e.g. {\"straws\": 600, \"soil_bgr\": "
+                    "[0.2, 0.25, 0.3]} (docs/simulator.md, \"Scenes of your own\")"),
       ParamSpec::integer("seed", 1).range(0, std::nullopt).describe("scene and noise seed"),
       ParamSpec::integer("frames", 0)
           .range(0, std::nullopt)

@@ -1,11 +1,12 @@
 // The scene simulator against geometry computed independently: flat soil gives eq. 1's
 // inverse exactly before noise; the truth follows the soil layers of the moving
 // platform; frames are deterministic per seed; residue shows in the truth mask; cracks lie
-// below the soil.
+// below the soil; a scene's own fields change a preset, and bad ones are refused by name.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
@@ -199,6 +200,52 @@ TEST_F(SceneTest, BayerMosaicKeepsOneChannelPerPixel) {
   EXPECT_EQ(mosaic.at<std::uint8_t>(100, 201), colour.at<cv::Vec3b>(100, 201)[1]);
   EXPECT_EQ(mosaic.at<std::uint8_t>(101, 200), colour.at<cv::Vec3b>(101, 200)[1]);
   EXPECT_EQ(mosaic.at<std::uint8_t>(101, 201), colour.at<cv::Vec3b>(101, 201)[0]);
+}
+
+// The `scene` parameter changes the preset's fields: case D without its straws and stubble
+// is bare soil (no residue pixel in the truth), 600 mm away, of the colour given.
+TEST_F(SceneTest, SceneFieldsChangeThePreset) {
+  const auto changed = frames({{"preset", "case_d"},
+                               {"color_noise", 0.0},
+                               {"scene",
+                                {{"straws", 0},
+                                 {"stubble", 0},
+                                 {"ground_distance_mm", 600.0},
+                                 {"soil_bgr", {0.1, 0.2, 0.6}}}}},
+                              1);
+  ASSERT_EQ(changed.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(changed[0].truth.residue_mask != ResidueMask::kSoil), 0);
+  EXPECT_DOUBLE_EQ(*changed[0].truth.distance_mm, 600.0);
+  // Reflectance ratio red to blue 6 (the preset's soil: 2), under a white sun and a grey sky.
+  const cv::Scalar mean = cv::mean(changed[0].color.pixels);
+  EXPECT_NEAR(mean[2] / mean[0], 6.0, 0.3);
+  EXPECT_NEAR(mean[1] / mean[0], 2.0, 0.1);
+}
+
+TEST_F(SceneTest, BadSceneFieldsAreRefusedByName) {
+  const auto refused = [&](nlohmann::json scene) {
+    try {
+      frames({{"preset", "case_a"}, {"scene", std::move(scene)}}, 1);
+    } catch (const std::exception& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  using ::testing::HasSubstr;
+  EXPECT_THAT(refused({{"strawz", 10}}),
+              HasSubstr("no preset field 'strawz'; the fields are ground_distance_mm, stubble"));
+  EXPECT_THAT(refused({{"straws", -1}}),
+              HasSubstr("field 'straws': expected an integer from 0 to 50000, got -1"));
+  EXPECT_THAT(refused({{"straws", 2.5}}), HasSubstr("field 'straws': expected an integer"));
+  EXPECT_THAT(refused({{"soil_bgr", {0.1, 0.2}}}),
+              HasSubstr("field 'soil_bgr': expected [3 numbers] each from 0 to 1, got [0.1,0.2]"));
+  EXPECT_THAT(refused({{"straw_length_mm", {200, 40}}}),
+              HasSubstr("the first not above the second"));
+  EXPECT_THAT(refused({{"shadows", 1}}), HasSubstr("field 'shadows': expected true or false"));
+  EXPECT_THAT(refused({{"stubble_height_mm", 10}, {"stubble_height_spread_mm", 20}}),
+              HasSubstr("stalks would grow below the soil"));
+  EXPECT_THAT(refused({{"layers_mm", {0, 5}}}), HasSubstr("need a track"));
+  EXPECT_THAT(refused(5), HasSubstr("expected an object of preset fields, got 5"));
 }
 
 }  // namespace

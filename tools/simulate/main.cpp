@@ -31,6 +31,8 @@ an image-folder recording.
 
   --preset NAME          scene preset (default case_c; `tilth describe synthetic.scene`
                          lists them)
+  --scene JSON           change the preset's fields, e.g. '{"straws": 600}' (the
+                         fields: docs/simulator.md, "Scenes of your own")
   --frames N             frames to render (default: the preset's count)
   --seed N               scene and noise seed (default 1); the same seed gives the same
                          frames
@@ -84,9 +86,9 @@ int main(int argc, char** argv) {
   std::optional<CommandLine> parsed;
   try {
     parsed.emplace(argc, argv, 1,
-                   std::set<std::string>{"--preset", "--frames", "--seed", "--fps", "--calibration",
-                                         "--color-format", "--tof-noise", "--color-noise",
-                                         "--format", "--compression"},
+                   std::set<std::string>{"--preset", "--scene", "--frames", "--seed", "--fps",
+                                         "--calibration", "--color-format", "--tof-noise",
+                                         "--color-noise", "--format", "--compression"},
                    std::set<std::string>{"--overwrite", "--help"});
   } catch (const tilth::Error& error) {
     return usage_error(error.what());
@@ -137,6 +139,7 @@ int main(int argc, char** argv) {
       if (const auto text = line.value(option)) graph.set_from_option(node, param, option, *text);
     };
     pass("--preset", "scene", "preset");
+    pass("--scene", "scene", "scene");
     pass("--frames", "scene", "frames");
     pass("--seed", "scene", "seed");
     pass("--fps", "scene", "fps");
