@@ -284,9 +284,10 @@ def print_matrix_intro(args):
 
 def print_random_intro(args):
     print("# Accuracy on scenes drawn at random\n")
+    options = " --frames %d" % args.frames if args.frames != 8 else ""
+    options += " --field-only" if args.field_only else ""
     print("Produced by `python3 tools/accuracy.py --random %d --seed %d%s`: %d scenes drawn"
-          % (args.random, args.seed, " --frames %d" % args.frames if args.frames != 8 else "",
-             args.random))
+          % (args.random, args.seed, options, args.random))
     print("from the ranges a field has (`random_scene` in the script; the scenes are listed")
     print("at the end), %d frames each. Errors, bounds and columns as in docs/accuracy.md.\n"
           % args.frames)
