@@ -17,10 +17,11 @@ struct Field {
   Setter set;
 };
 
-std::string shown(const nlohmann::json& value) {
-  const std::string text = value.dump();
+std::string shortened(const std::string& text) {
   return text.size() > 60 ? text.substr(0, 57) + "..." : text;
 }
+
+std::string shown(const nlohmann::json& value) { return shortened(value.dump()); }
 
 [[noreturn]] void reject(const std::string& field, const std::string& expected,
                          const nlohmann::json& value) {
@@ -153,6 +154,12 @@ std::vector<std::string> preset_field_names() {
 
 ScenePreset changed_preset(ScenePreset preset, const nlohmann::json& changes) {
   if (changes.is_null()) return preset;
+  if (changes.is_string()) {
+    throw Error(
+        "parameter 'scene': expected a JSON object of preset fields, got text that is "
+        "not JSON: " +
+        shortened(changes.get<std::string>()));
+  }
   if (!changes.is_object()) {
     throw Error("parameter 'scene': expected an object of preset fields, got " + shown(changes));
   }

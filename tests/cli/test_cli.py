@@ -1,5 +1,6 @@
 """The `tilth` command line, run as a user runs it: exit codes, messages, and clean
 shutdown on SIGINT / SIGTERM with nothing lost."""
+import json
 import os
 import re
 import signal
@@ -178,6 +179,35 @@ class UntrustedInput(unittest.TestCase):
                       "(graph file '/dev/zero')", result.stderr)
         self.assertIn(path + ":/include/1/file: is a FIFO; expected a regular file (graph file '" +
                       fifo + "')", result.stderr)
+
+
+class Simulate(unittest.TestCase):
+    def test_scene_fields_change_the_preset(self):
+        with tempfile.TemporaryDirectory() as work:
+            out = os.path.join(work, "rec")
+            result = tilth("simulate", out, "--preset", "case_a", "--frames", "1",
+                           "--scene", '{"ground_distance_mm": 600, "straws": 0}')
+            self.assertEqual(result.returncode, 0, result.stderr)
+            with open(os.path.join(out, "frames.csv")) as f:
+                self.assertTrue(f.read().splitlines()[1].endswith(",600.00"))
+            with open(os.path.join(out, "recording.json")) as f:
+                self.assertIn('--scene {"ground_distance_mm": 600, "straws": 0}',
+                              json.load(f)["description"])
+
+    def test_bad_scene_is_refused_by_name_and_writes_nothing(self):
+        with tempfile.TemporaryDirectory() as work:
+            out = os.path.join(work, "rec")
+            for scene, expected in [
+                    ('{"strawz": 1}', "no preset field 'strawz'; the fields are "
+                                      "ground_distance_mm, stubble,"),
+                    ('{"tilt_x_deg": 40}', "field 'tilt_x_deg': expected a number from -30 "
+                                           "to 30, got 40"),
+                    ('{"straws": 1', 'expected a JSON object of preset fields, got text that is '
+                                     'not JSON: {"straws": 1')]:
+                result = tilth("simulate", out, "--scene", scene)
+                self.assertEqual(result.returncode, 1, result.stderr)
+                self.assertIn("parameter 'scene': " + expected, result.stderr)
+                self.assertFalse(os.path.exists(out))
 
 
 class Run(unittest.TestCase):
