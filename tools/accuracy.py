@@ -360,6 +360,9 @@ def main():
     parser.add_argument("--tilth", default=os.environ.get(
         "TILTH", os.path.join(SOURCE, "build", "bin", "tilth")))
     args = parser.parse_args()
+    if args.random and (args.small or args.tof_noise is not None or args.color_noise is not None):
+        parser.error("--random draws each scene's noise and conditions itself: no --small, "
+                     "--tof-noise or --color-noise with it")
     if args.frames is None:
         args.frames = 3 if args.small else 8
     with tempfile.TemporaryDirectory(prefix="tilth-accuracy-") as work:

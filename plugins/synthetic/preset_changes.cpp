@@ -4,6 +4,8 @@
 #include <array>
 #include <functional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "tilth/error.h"
 
@@ -29,10 +31,14 @@ std::string shown(const nlohmann::json& value) { return shortened(value.dump());
               shown(value));
 }
 
-std::string range_text(double low, double high) {
+std::string number_text(double value) {
   std::ostringstream text;
-  text << "from " << low << " to " << high;
+  text << value;
   return text.str();
+}
+
+std::string range_text(double low, double high) {
+  return "from " + number_text(low) + " to " + number_text(high);
 }
 
 double in_range(const std::string& field, const nlohmann::json& value, double low, double high,
@@ -144,21 +150,21 @@ std::string joined(const std::vector<std::string>& names) {
   return text;
 }
 
-}  // namespace
-
-std::vector<std::string> preset_field_names() {
+std::vector<std::string> field_names() {
   std::vector<std::string> names;
   for (const auto& field : fields()) names.push_back(field.name);
   return names;
 }
 
+}  // namespace
+
 ScenePreset changed_preset(ScenePreset preset, const nlohmann::json& changes) {
   if (changes.is_null()) return preset;
   if (changes.is_string()) {
     throw Error(
-        "parameter 'scene': expected a JSON object of preset fields, got text that is "
-        "not JSON: " +
-        shortened(changes.get<std::string>()));
+        "parameter 'scene': expected a JSON object of preset fields such as {\"straws\": 600}, "
+        "got the text '" +
+        shortened(changes.get<std::string>()) + "'");
   }
   if (!changes.is_object()) {
     throw Error("parameter 'scene': expected an object of preset fields, got " + shown(changes));
@@ -169,14 +175,14 @@ ScenePreset changed_preset(ScenePreset preset, const nlohmann::json& changes) {
         std::find_if(known.begin(), known.end(), [&](const Field& f) { return f.name == name; });
     if (field == known.end()) {
       throw Error("parameter 'scene': no preset field '" + name + "'; the fields are " +
-                  joined(preset_field_names()));
+                  joined(field_names()));
     }
     field->set(preset, value);
   }
   if (preset.stubble_height_spread_mm > preset.stubble_height_mm) {
     throw Error("parameter 'scene': stubble_height_spread_mm (" +
-                std::to_string(preset.stubble_height_spread_mm) +
-                ") is more than stubble_height_mm (" + std::to_string(preset.stubble_height_mm) +
+                number_text(preset.stubble_height_spread_mm) +
+                ") is more than stubble_height_mm (" + number_text(preset.stubble_height_mm) +
                 "): stalks would grow below the soil");
   }
   if ((!preset.layers_mm.empty() || preset.speed_mm_per_s != 0.0) &&

@@ -5,9 +5,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <string>
-#include <vector>
-
 #include "scene_preset.h"
 
 namespace tilth::synthetic {
@@ -15,8 +12,5 @@ namespace tilth::synthetic {
 // `preset` with every field `changes` names set to its value. Throws tilth::Error naming
 // the field, what it expected and what it got, and the fields known when a name is not one.
 ScenePreset changed_preset(ScenePreset preset, const nlohmann::json& changes);
-
-// The fields changed_preset knows, in the order of ScenePreset.
-std::vector<std::string> preset_field_names();
 
 }  // namespace tilth::synthetic

@@ -202,8 +202,8 @@ class Simulate(unittest.TestCase):
                                       "ground_distance_mm, stubble,"),
                     ('{"tilt_x_deg": 40}', "field 'tilt_x_deg': expected a number from -30 "
                                            "to 30, got 40"),
-                    ('{"straws": 1', 'expected a JSON object of preset fields, got text that is '
-                                     'not JSON: {"straws": 1')]:
+                    ('{"straws": 1', "expected a JSON object of preset fields such as "
+                                     "{\"straws\": 600}, got the text '{\"straws\": 1'")]:
                 result = tilth("simulate", out, "--scene", scene)
                 self.assertEqual(result.returncode, 1, result.stderr)
                 self.assertIn("parameter 'scene': " + expected, result.stderr)
